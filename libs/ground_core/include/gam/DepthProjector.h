@@ -1,0 +1,81 @@
+// Ground-aware mapping for MRPT
+// Projects a depth (or range) image straight into 2.5D grid bins, without
+// building an intermediate point cloud. Pure code: the caller passes the image
+// memory, the pinhole intrinsics and the sensor pose in the grid frame.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "gam/ElevationGrid.h"
+
+namespace gam
+{
+/** Pinhole intrinsics of the depth image (pixels). */
+struct PinholeIntrinsics
+{
+	int width = 0, height = 0;
+	double fx = 0, fy = 0, cx = 0, cy = 0;
+	bool operator==(const PinholeIntrinsics& o) const
+	{
+		return width == o.width && height == o.height && fx == o.fx && fy == o.fy && cx == o.cx &&
+			   cy == o.cy;
+	}
+	/** Throws std::invalid_argument naming the bad value. */
+	void validate() const;
+};
+
+/** A read-only view of a 16-bit range image (row-major, `stride` elements per row). */
+struct RangeImageView
+{
+	const uint16_t* data = nullptr;
+	int rows = 0, cols = 0;
+	size_t stride = 0;
+	float units = 0.001f;  ///< metres per unit
+	/** true: the value is the depth along the sensor +X axis (Kinect);
+	 * false: the Euclidean range along the pixel ray. */
+	bool is_depth = true;
+	uint16_t at(int r, int c) const { return data[size_t(r) * stride + size_t(c)]; }
+};
+
+/** What the projector keeps. Heights are in the grid frame. */
+struct ProjectionFilter
+{
+	float min_range = 0.0f;	 ///< metres along the sensor +X (depth) or the ray (range)
+	float max_range = 5.0f;
+	float z_min = -std::numeric_limits<float>::infinity();
+	float z_max = std::numeric_limits<float>::infinity();
+	int decimation = 1;	 ///< use every n-th row and column
+};
+
+/** Rigid transform sensor -> grid frame (row-major rotation and translation).
+ * The sensor frame is MRPT's: +X forward, +Y left, +Z up. */
+struct RigidTransform
+{
+	Eigen::Matrix3f R = Eigen::Matrix3f::Identity();
+	Eigen::Vector3f t = Eigen::Vector3f::Zero();
+};
+
+class DepthProjector
+{
+   public:
+	/** Bins every valid pixel into `out` (appends). Pixels that are 0, beyond
+	 * the range limits, outside the grid or the z band are skipped.
+	 * Returns the number of pixels binned. Throws std::invalid_argument if the
+	 * image and the intrinsics disagree. */
+	size_t project(
+		const RangeImageView& img, const PinholeIntrinsics& K, const RigidTransform& sensorToGrid,
+		const ProjectionFilter& f, const ElevationGrid& grid, BinnedPoints& out);
+
+	/** Per-pixel ray factors (x = 1; y, z) of the last intrinsics used. */
+	const std::vector<Eigen::Vector2f>& rayLut() const { return m_lut; }
+
+   private:
+	void updateLut(const PinholeIntrinsics& K);
+	PinholeIntrinsics m_lutK;
+	std::vector<Eigen::Vector2f> m_lut;	// (y/x, z/x) per pixel
+	std::vector<float> m_lutNorm;  // |(1, y/x, z/x)| per pixel, for range images
+};
+
+}  // namespace gam

@@ -1,0 +1,191 @@
+// Ground-aware mapping for MRPT
+// The 2.5D grid of the paper (§IV.A): every cell keeps z-min, z-max and the
+// sample count N_z of the points that fell into it, plus the sums the 3-sigma
+// filter needs. Pure data + algorithm: no MRPT, no I/O.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+namespace gam
+{
+/** Axis-aligned, regular 2D grid: cell (ix, iy) covers
+ *  [x_min + ix*res, x_min + (ix+1)*res) x [y_min + iy*res, ...). */
+struct GridGeometry
+{
+	double x_min = -5, y_min = -5;
+	double resolution = 0.05;
+	int nx = 200, ny = 200;
+
+	double x_max() const { return x_min + nx * resolution; }
+	double y_max() const { return y_min + ny * resolution; }
+	size_t cellCount() const { return size_t(nx) * size_t(ny); }
+	/** Cell index along x, possibly outside [0, nx). */
+	int ix(double x) const { return int(std::floor((x - x_min) / resolution)); }
+	int iy(double y) const { return int(std::floor((y - y_min) / resolution)); }
+	bool inside(int cx, int cy) const { return cx >= 0 && cy >= 0 && cx < nx && cy < ny; }
+	double cx(int ix_) const { return x_min + (ix_ + 0.5) * resolution; }
+	double cy(int iy_) const { return y_min + (iy_ + 0.5) * resolution; }
+	size_t index(int cx_, int cy_) const { return size_t(cy_) * size_t(nx) + size_t(cx_); }
+
+	/** Throws std::invalid_argument naming the bad value. */
+	void validate() const;
+	bool operator==(const GridGeometry& o) const
+	{
+		return x_min == o.x_min && y_min == o.y_min && resolution == o.resolution && nx == o.nx &&
+			   ny == o.ny;
+	}
+};
+
+/** One column of the 2.5D map. Heights in metres, in the grid's frame. */
+struct ElevationCell
+{
+	float z_min = std::numeric_limits<float>::infinity();
+	float z_max = -std::numeric_limits<float>::infinity();
+	uint32_t count = 0;	 ///< N_z, after outlier removal
+	float z_sum = 0;  ///< sum of z (for the mean)
+	float z_sq_sum = 0;	 ///< sum of z^2 (for the variance)
+	/** Inverse-distance-weighted height estimate for cells with count == 0
+	 * (NaN when not interpolated). Never counts as an observation. */
+	float z_idw = std::numeric_limits<float>::quiet_NaN();
+
+	bool observed() const { return count > 0; }
+	float mean() const { return count ? z_sum / float(count) : std::numeric_limits<float>::quiet_NaN(); }
+	float variance() const
+	{
+		if (count < 2) return 0.f;
+		const float m = mean();
+		return std::max(0.f, z_sq_sum / float(count) - m * m);
+	}
+	float span() const { return count ? z_max - z_min : 0.f; }
+	void add(float z)
+	{
+		if (z < z_min) z_min = z;
+		if (z > z_max) z_max = z;
+		++count;
+		z_sum += z;
+		z_sq_sum += z * z;
+	}
+	void merge(const ElevationCell& o)
+	{
+		if (!o.count) return;
+		z_min = std::min(z_min, o.z_min);
+		z_max = std::max(z_max, o.z_max);
+		count += o.count;
+		z_sum += o.z_sum;
+		z_sq_sum += o.z_sq_sum;
+		z_idw = std::numeric_limits<float>::quiet_NaN();
+	}
+};
+
+/** Height samples of one frame, already binned: the cell index and the z of each
+ * point. Filled by the projectors (DepthProjector, or any point source), then
+ * merged into an ElevationGrid. Reused between frames to avoid allocations. */
+struct BinnedPoints
+{
+	std::vector<uint32_t> cell;
+	std::vector<float> z;
+	void clear()
+	{
+		cell.clear();
+		z.clear();
+	}
+	size_t size() const { return cell.size(); }
+	void push(uint32_t c, float zz)
+	{
+		cell.push_back(c);
+		z.push_back(zz);
+	}
+};
+
+/** Per-cell outlier removal (paper §IV.A: the 3-sigma rule). */
+struct OutlierFilterParams
+{
+	bool enabled = true;
+	float sigmas = 3.0f;  ///< keep |z - mean| <= sigmas * std
+	/** Cells with fewer samples keep all of them: with n points no sample can be
+	 * more than (n-1)/sqrt(n) std away, so the rule is void for n <= 10 anyway. */
+	uint32_t min_count = 4;
+};
+
+/** Inverse distance weighting densification (fills empty cells). */
+struct IdwParams
+{
+	int radius_cells = 0;  ///< 0 disables it
+	float power = 2.0f;
+	int min_neighbours = 3;	 ///< observed cells needed in the window
+};
+
+class ElevationGrid
+{
+   public:
+	ElevationGrid() { resize(GridGeometry{}); }
+	explicit ElevationGrid(const GridGeometry& g) { resize(g); }
+
+	/** Sets the geometry and empties every cell. */
+	void resize(const GridGeometry& g);
+	/** Moves the grid (same size and resolution) and empties it; cheap when only
+	 * a few cells were touched since the last clear. */
+	void recenter(double x_min, double y_min);
+	void clear();
+
+	const GridGeometry& geometry() const { return m_geom; }
+	const ElevationCell& cell(int cx, int cy) const { return m_cells[m_geom.index(cx, cy)]; }
+	const ElevationCell& cell(size_t idx) const { return m_cells[idx]; }
+	ElevationCell& cellMutable(size_t idx) { return m_cells[idx]; }
+	const std::vector<ElevationCell>& cells() const { return m_cells; }
+	std::vector<ElevationCell>& cellsMutable() { return m_cells; }
+	/** Indices of the cells with count > 0 (in first-touched order). */
+	const std::vector<uint32_t>& observedCells() const { return m_touched; }
+	size_t observedCount() const { return m_touched.size(); }
+
+	/** Bins one point; returns false (and does nothing) if it falls outside. */
+	bool binPoint(double x, double y, float z, BinnedPoints& out) const
+	{
+		const int cx = m_geom.ix(x), cy = m_geom.iy(y);
+		if (!m_geom.inside(cx, cy)) return false;
+		out.push(uint32_t(m_geom.index(cx, cy)), z);
+		return true;
+	}
+
+	/** Adds a frame's samples: they are accumulated per cell, optionally
+	 * filtered with the 3-sigma rule (within this frame), then merged into the
+	 * grid. Returns the number of samples kept. */
+	size_t insert(const BinnedPoints& pts, const OutlierFilterParams& filter);
+
+	/** Sets a cell's statistics directly (deserialization). */
+	void restoreCell(size_t idx, const ElevationCell& c)
+	{
+		if (!m_cells[idx].count && c.count) m_touched.push_back(uint32_t(idx));
+		m_cells[idx] = c;
+	}
+
+	/** Fills z_idw of empty cells from observed ones in a (2r+1)^2 window.
+	 * Returns how many cells got an estimate. Restricted to the bounding box of
+	 * the observed cells grown by r. */
+	size_t interpolateIdw(const IdwParams& p);
+
+	/** Surface height of a cell for ground fitting: the mean of an observed cell,
+	 * else the IDW estimate; NaN if neither. */
+	float surfaceHeight(int cx, int cy) const
+	{
+		const ElevationCell& c = cell(cx, cy);
+		return c.count ? c.mean() : c.z_idw;
+	}
+
+   private:
+	GridGeometry m_geom;
+	std::vector<ElevationCell> m_cells;
+	std::vector<uint32_t> m_touched;  // cells with count > 0
+	std::vector<uint32_t> m_idwTouched;	 // cells holding an IDW value
+	// Frame scratch (kept to avoid per-frame allocations):
+	std::vector<ElevationCell> m_frame;
+	std::vector<uint32_t> m_frameTouched;
+	std::vector<float> m_filterMean, m_filterLimit;
+	std::vector<float> m_idwWeights;
+};
+
+}  // namespace gam

@@ -1,0 +1,119 @@
+// Ground-aware mapping for MRPT
+// Inverse sensor model (paper §IV.C, eq. 4-6): turns the voxels of a frame's
+// 2.5D map and the detected ground into occupancy evidence for 2D cells.
+// Pure code: the result is a per-cell probability of being occupied in the
+// frame grid, which the MRPT map then fuses in log-odds.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "gam/ElevationGrid.h"
+#include "gam/RrtGroundDetector.h"
+
+namespace gam
+{
+struct IsmParams
+{
+	double d_pth = 0.03;  ///< plane distance threshold [m]: |d| <= d_pth is ground
+	double K_g = 0.3;  ///< ground gain: a ground voxel says P(occ) = 0.5 - K_g * G(d)
+	double sigma2 = 0.02;  ///< variance of G(d) = exp(-d^2 / (2 sigma2)) [m^2]
+	double K_n = 0.0005;  ///< density gain [m^3 per point]
+	double d_min = 3.0;	 ///< density offset of the sigmoid
+	double K_m = 0.8;  ///< obstacle gain: P(occ) = 0.5 + 0.5 * K_m * P_rho
+	/** Voxels whose bottom is more than this above the ground do not block
+	 * (ceiling, door frames, beams above the robot). [m] */
+	double robot_height = 1.8;
+	/** Voxels farther than this from the sensor (2D) are ignored. [m] */
+	double max_range = 5.0;
+	/** Below-ground voxels also mark the cells between the point where their
+	 * ray crossed the ground plane and the voxel: no floor was there. */
+	bool drop_rays = true;
+	double max_drop_ray_length = 2.0;  ///< [m]
+	/** Use the tree's extra ground patches (ramps) near their nodes. */
+	bool local_planes = true;
+	/** How far from its nodes a ground patch applies. [m] */
+	double plane_support_radius = 0.4;
+
+	void validate() const;
+};
+
+/** The formulas, exposed for tests. */
+namespace ism
+{
+/** Points per cubic metre of a voxel: N_z / (d_r^2 * max(span, d_r)). */
+double voxelDensity(uint32_t count, double span, double resolution);
+/** Eq. (4): P_rho = 1 / (1 + exp(-(K_n * rho - d_min))). */
+double densityConfidence(double rho, const IsmParams& p);
+/** Eq. (5): P(occ) of an obstacle voxel, in [0.5, 0.5 + 0.5*K_m]. */
+double obstacleProbability(double densityConfidence, const IsmParams& p);
+/** Eq. (6): P(occ) of a ground voxel at plane distance d. */
+double groundProbability(double d, const IsmParams& p);
+/** Combines two pieces of evidence for one cell within a frame: occupied
+ * evidence wins (the largest one), otherwise the strongest free one. */
+inline float combine(float a, float b)
+{
+	if (a > 0.5f || b > 0.5f) return a > b ? a : b;
+	return a < b ? a : b;
+}
+}  // namespace ism
+
+enum class VoxelClass : uint8_t
+{
+	None = 0,
+	Ground,
+	Obstacle,  ///< sticks out above the ground
+	Drop,  ///< entirely below the ground: hole, outlet, downward step
+	Overhead,  ///< above robot_height: ignored
+	OutOfRange	///< beyond max_range: ignored
+};
+
+struct IsmStats
+{
+	size_t ground = 0, obstacle = 0, drop = 0, overhead = 0, out_of_range = 0;
+	size_t drop_ray_cells = 0;
+	bool applied = false;  ///< false when there was no ground plane
+};
+
+class InverseSensorModel
+{
+   public:
+	explicit InverseSensorModel(const IsmParams& p = {}) : m_params(p) {}
+	void setParams(const IsmParams& p) { m_params = p; }
+	const IsmParams& params() const { return m_params; }
+
+	/** Computes the evidence of one frame. `sensor` is the sensor position in
+	 * the grid frame. With no ground plane (det.ok() false) nothing is produced:
+	 * a frame without ground never invents obstacles. */
+	void compute(
+		const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor,
+		IsmStats& stats);
+
+	/** P(occupied) per frame cell; 0.5 where there is no evidence. */
+	const std::vector<float>& evidence() const { return m_evidence; }
+	/** Cells with evidence != 0.5 (indices into the frame grid). */
+	const std::vector<uint32_t>& evidenceCells() const { return m_evidenceCells; }
+	/** Class of each observed frame cell (None elsewhere). */
+	const std::vector<VoxelClass>& classes() const { return m_class; }
+
+	/** Classification of one voxel against one plane (exposed for tests). */
+	VoxelClass classify(const ElevationCell& c, double x, double y, const Plane& pl, double& dMean) const;
+
+   private:
+	void put(uint32_t cell, float p);
+	const Plane& choosePlane(const GroundDetection& det, const ElevationCell& c, double x, double y, int block) const;
+	void buildSupport(const GridGeometry& g, const GroundDetection& det);
+
+	IsmParams m_params;
+	std::vector<float> m_evidence;
+	std::vector<uint32_t> m_evidenceCells;
+	std::vector<VoxelClass> m_class;
+	std::vector<uint32_t> m_classCells;
+	std::vector<uint32_t> m_dropVoxels;
+	// Local-plane support raster: bit k set = plane k applies in that block.
+	std::vector<uint8_t> m_support;
+	int m_blockCells = 4, m_bnx = 0, m_bny = 0;
+};
+
+}  // namespace gam

@@ -1,0 +1,125 @@
+// Ground-aware mapping for MRPT
+// RRT-GPD: ground-plane detection with a rapidly-exploring random tree grown
+// over local least-squares plane fits of the 2.5D map (paper §IV.B, Alg. 1),
+// followed by RANSAC on the node centres. Pure code over a read-only grid.
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "gam/ElevationGrid.h"
+#include "gam/PlaneFit.h"
+
+namespace gam
+{
+struct RrtGpdParams
+{
+	int iterations = 600;  ///< K
+	/** N_th: a node is ground-like if the horizontal part of its local unit
+	 * normal (the sine of its tilt) is at most this. 0.2 = 11.5 deg. */
+	double normal_threshold = 0.2;
+	/** E_th [m]: a new node's height may differ from its parent's local plane,
+	 * extrapolated to the new position, by at most this. */
+	double elevation_threshold = 0.05;
+	int neighbourhood_x = 3;  ///< s_x [cells], odd
+	int neighbourhood_y = 3;  ///< s_y [cells], odd
+	double expansion_distance = 0.4;  ///< d_n [m]
+
+	/** Cells whose height spread (std) exceeds this are not surfaces (walls,
+	 * edges) and take no part in local fits. [m] */
+	double max_cell_std = 0.05;
+	/** Local fits with a larger RMS residual are not planar. [m] */
+	double max_fit_rms = 0.025;
+	/** A neighbourhood needs at least this many cells with a height. */
+	int min_valid_cells = 5;
+	/** The seed is the valid cell nearest to the robot within this radius [m]
+	 * whose height is within seed_height_tolerance of the expected floor. */
+	double seed_search_radius = 3.0;
+	double seed_height_tolerance = 0.3;
+	/** Margin [m] added around the explored nodes to form the sampling window. */
+	double window_margin = 1.0;
+	/** Fewer nodes than this: "too few nodes", no plane. */
+	size_t min_nodes = 8;
+	/** RANSAC over the node centres. */
+	int ransac_iterations = 100;
+	double ransac_inlier_distance = 0.025;	///< [m]
+	/** Extra planes (ramps) need this many supporting nodes; 0 disables them. */
+	size_t min_nodes_per_extra_plane = 3;
+	int max_planes = 3;
+	uint32_t random_seed = 1;
+
+	/** Throws std::invalid_argument naming the parameter out of range. */
+	void validate() const;
+};
+
+struct GroundNode
+{
+	float x = 0, y = 0, z = 0;	///< centre (cell centre, surface height)
+	Plane local;  ///< least-squares plane of its s_x * s_y neighbourhood
+	int parent = -1;
+	int plane_id = -1;	///< index into GroundDetection::planes, -1 = none
+};
+
+struct GroundDetection
+{
+	enum class Status
+	{
+		Ok,
+		EmptyGrid,	///< no observed cell at all
+		NoValidSeed,  ///< nothing planar near the robot at floor height
+		TooFewNodes,  ///< the tree did not grow: no floor of useful size
+		NoConsensus	 ///< RANSAC found no plane among the nodes
+	};
+	Status status = Status::EmptyGrid;
+	/** planes[0] is the ground plane; later ones are smaller ground patches
+	 * (ramps) supported by at least min_nodes_per_extra_plane nodes. */
+	std::vector<Plane> planes;
+	std::vector<size_t> plane_support;	///< nodes per plane
+	std::vector<GroundNode> nodes;
+	int iterations = 0;
+
+	bool ok() const { return status == Status::Ok; }
+	const Plane& plane() const { return planes.front(); }
+	static const char* statusName(Status s);
+	std::string describe() const;
+};
+
+/** Expected floor: where the robot stands. */
+struct GroundSeedHint
+{
+	double x = 0, y = 0;  ///< robot position in the grid frame
+	double floor_z = 0;	 ///< expected floor height in the grid frame
+};
+
+class RrtGroundDetector
+{
+   public:
+	explicit RrtGroundDetector(const RrtGpdParams& p = {}) : m_params(p) {}
+	void setParams(const RrtGpdParams& p) { m_params = p; }
+	const RrtGpdParams& params() const { return m_params; }
+
+	/** Runs Algorithm 1 on `grid`. Deterministic for equal inputs and seed. */
+	void detect(const ElevationGrid& grid, const GroundSeedHint& hint, GroundDetection& out);
+
+	/** Local least-squares plane of the s_x * s_y cells around (cx, cy), using
+	 * observed heights and IDW estimates. False if too few cells or degenerate. */
+	bool fitLocalPlane(const ElevationGrid& grid, int cx, int cy, Plane& plane, double& rms) const;
+
+   private:
+	bool cellHeight(const ElevationGrid& grid, int cx, int cy, float& z) const;
+	bool findSeed(const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed);
+	void fitPlanes(GroundDetection& out);
+
+	RrtGpdParams m_params;
+	std::mt19937 m_rng;
+	// Scratch, reused between frames:
+	std::vector<uint8_t> m_hasNode;
+	std::vector<uint32_t> m_nodeCells;
+	mutable std::vector<Eigen::Vector3d> m_fitPts;
+	std::vector<std::pair<int, int>> m_ringOffsets;
+	int m_ringRadius = -1;
+};
+
+}  // namespace gam

@@ -1,0 +1,233 @@
+#include "gam/InverseSensorModel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace gam
+{
+namespace
+{
+void require(bool ok, const char* name, const char* range, double v)
+{
+	if (!ok)
+	{
+		std::ostringstream s;
+		s << name << " must be " << range << " (got " << v << ")";
+		throw std::invalid_argument(s.str());
+	}
+}
+}  // namespace
+
+void IsmParams::validate() const
+{
+	require(d_pth > 0 && d_pth < 10, "d_pth", "in (0, 10) m", d_pth);
+	require(K_g >= 0 && K_g < 0.5, "K_g", "in [0, 0.5)", K_g);
+	require(sigma2 > 0, "sigma2", "> 0 m^2", sigma2);
+	require(K_n > 0, "K_n", "> 0", K_n);
+	require(std::isfinite(d_min), "d_min", "finite", d_min);
+	require(K_m >= 0 && K_m < 1, "K_m", "in [0, 1)", K_m);
+	require(robot_height > 0, "robot_height", "> 0 m", robot_height);
+	require(max_range > 0, "max_range", "> 0 m", max_range);
+	require(max_drop_ray_length >= 0, "max_drop_ray_length", ">= 0 m", max_drop_ray_length);
+	require(plane_support_radius >= 0, "plane_support_radius", ">= 0 m", plane_support_radius);
+}
+
+namespace ism
+{
+double voxelDensity(uint32_t count, double span, double resolution)
+{
+	const double h = std::max(span, resolution);
+	return double(count) / (resolution * resolution * h);
+}
+double densityConfidence(double rho, const IsmParams& p)
+{
+	return 1.0 / (1.0 + std::exp(-(p.K_n * rho - p.d_min)));
+}
+double obstacleProbability(double pr, const IsmParams& p) { return 0.5 + 0.5 * p.K_m * pr; }
+double groundProbability(double d, const IsmParams& p)
+{
+	return 0.5 - p.K_g * std::exp(-d * d / (2.0 * p.sigma2));
+}
+}  // namespace ism
+
+VoxelClass InverseSensorModel::classify(
+	const ElevationCell& c, double x, double y, const Plane& pl, double& dMean) const
+{
+	const double dTop = pl.signedDistance(x, y, c.z_max);
+	const double dBot = pl.signedDistance(x, y, c.z_min);
+	dMean = pl.signedDistance(x, y, c.mean());
+	const double th = m_params.d_pth;
+	if (dBot > m_params.robot_height) return VoxelClass::Overhead;
+	if (dTop < -th) return VoxelClass::Drop;
+	if (dTop > th) return VoxelClass::Obstacle;
+	// Top within the band; a bottom far below it is the edge of a hole.
+	if (dBot < -th) return VoxelClass::Drop;
+	return VoxelClass::Ground;
+}
+
+void InverseSensorModel::put(uint32_t cell, float p)
+{
+	float& e = m_evidence[cell];
+	if (e == 0.5f) m_evidenceCells.push_back(cell);
+	e = ism::combine(e, p);
+}
+
+void InverseSensorModel::buildSupport(const GridGeometry& g, const GroundDetection& det)
+{
+	const int B = m_blockCells;
+	m_bnx = (g.nx + B - 1) / B;
+	m_bny = (g.ny + B - 1) / B;
+	m_support.assign(size_t(m_bnx) * size_t(m_bny), 0);
+	if (!m_params.local_planes || det.planes.size() < 2) return;
+	const double bres = B * g.resolution;
+	const int rb = int(std::ceil(m_params.plane_support_radius / bres));
+	for (const GroundNode& n : det.nodes)
+	{
+		if (n.plane_id < 1) continue;
+		const int bx = int(std::floor((n.x - g.x_min) / bres)), by = int(std::floor((n.y - g.y_min) / bres));
+		for (int yy = std::max(0, by - rb); yy <= std::min(m_bny - 1, by + rb); yy++)
+			for (int xx = std::max(0, bx - rb); xx <= std::min(m_bnx - 1, bx + rb); xx++)
+				m_support[size_t(yy) * size_t(m_bnx) + size_t(xx)] |= uint8_t(1u << n.plane_id);
+	}
+}
+
+const Plane& InverseSensorModel::choosePlane(
+	const GroundDetection& det, const ElevationCell& c, double x, double y, int block) const
+{
+	const uint8_t bits = m_support.empty() ? 0 : m_support[size_t(block)];
+	if (!bits) return det.planes.front();
+	// Among the main plane and the patches that apply here, the one the voxel
+	// fits best: a ramp voxel sits on the ramp, a box stands on both.
+	const Plane* best = &det.planes.front();
+	auto cost = [&](const Plane& pl) {
+		return std::max(
+			std::abs(pl.signedDistance(x, y, c.z_max)), std::abs(pl.signedDistance(x, y, c.z_min)));
+	};
+	double bestCost = cost(*best);
+	for (size_t k = 1; k < det.planes.size(); k++)
+		if (bits & (1u << k))
+		{
+			const double cst = cost(det.planes[k]);
+			if (cst < bestCost)
+			{
+				bestCost = cst;
+				best = &det.planes[k];
+			}
+		}
+	return *best;
+}
+
+void InverseSensorModel::compute(
+	const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor,
+	IsmStats& stats)
+{
+	m_params.validate();
+	stats = IsmStats{};
+	const GridGeometry& g = frame.geometry();
+	if (m_evidence.size() != g.cellCount())
+	{
+		m_evidence.assign(g.cellCount(), 0.5f);
+		m_class.assign(g.cellCount(), VoxelClass::None);
+		m_evidenceCells.clear();
+		m_classCells.clear();
+	}
+	for (uint32_t c : m_evidenceCells) m_evidence[c] = 0.5f;
+	m_evidenceCells.clear();
+	for (uint32_t c : m_classCells) m_class[c] = VoxelClass::None;
+	m_classCells.clear();
+	m_dropVoxels.clear();
+	if (!det.ok() || det.planes.empty()) return;
+	stats.applied = true;
+
+	buildSupport(g, det);
+	const double maxR2 = m_params.max_range * m_params.max_range;
+	const double res = g.resolution;
+
+	// Pass 1: every observed voxel updates its own cell.
+	for (uint32_t idx : frame.observedCells())
+	{
+		const ElevationCell& c = frame.cell(idx);
+		const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
+		const double x = g.cx(cx), y = g.cy(cy);
+		const double dx = x - sensor.x(), dy = y - sensor.y();
+		VoxelClass cls;
+		double dMean = 0;
+		if (dx * dx + dy * dy > maxR2)
+			cls = VoxelClass::OutOfRange;
+		else
+		{
+			const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
+			cls = classify(c, x, y, choosePlane(det, c, x, y, block), dMean);
+		}
+		m_class[idx] = cls;
+		m_classCells.push_back(idx);
+		switch (cls)
+		{
+			case VoxelClass::Ground:
+				stats.ground++;
+				put(idx, float(ism::groundProbability(dMean, m_params)));
+				break;
+			case VoxelClass::Obstacle:
+			case VoxelClass::Drop:
+			{
+				(cls == VoxelClass::Drop ? stats.drop : stats.obstacle)++;
+				const double rho = ism::voxelDensity(c.count, c.span(), res);
+				put(idx, float(ism::obstacleProbability(ism::densityConfidence(rho, m_params), m_params)));
+				if (cls == VoxelClass::Drop && m_params.drop_rays) m_dropVoxels.push_back(idx);
+				break;
+			}
+			case VoxelClass::Overhead: stats.overhead++; break;
+			case VoxelClass::OutOfRange: stats.out_of_range++; break;
+			case VoxelClass::None: break;
+		}
+	}
+
+	// Pass 2: the ray to a below-ground voxel crossed the ground plane and went
+	// on below it; no floor stopped it in between. Mark those cells, unless
+	// this frame saw ground there (a direct observation beats the inference).
+	for (uint32_t idx : m_dropVoxels)
+	{
+		const ElevationCell& c = frame.cell(idx);
+		const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
+		const double x = g.cx(cx), y = g.cy(cy);
+		const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
+		const Plane& pl = choosePlane(det, c, x, y, block);
+		const double hs = pl.signedDistance(sensor.x(), sensor.y(), sensor.z());
+		const double dp = pl.signedDistance(x, y, c.z_max);
+		if (!(hs > 0) || !(dp < 0)) continue;
+		const double t = hs / (hs - dp);  // ray parameter at the crossing
+		const double ex = sensor.x() + t * (x - sensor.x()), ey = sensor.y() + t * (y - sensor.y());
+		double lx = x - ex, ly = y - ey;
+		double len = std::sqrt(lx * lx + ly * ly);
+		if (len < res) continue;
+		if (len > m_params.max_drop_ray_length)
+		{
+			// Keep the part next to the voxel: far from it the plane estimate is
+			// extrapolated at a grazing angle.
+			const double s = m_params.max_drop_ray_length / len;
+			lx *= s;
+			ly *= s;
+			len = m_params.max_drop_ray_length;
+		}
+		const float p = m_evidence[idx];
+		const int steps = int(std::ceil(len / (0.5 * res)));
+		int lastCell = -1;
+		for (int s = 1; s < steps; s++)
+		{
+			const double f = double(s) / steps;
+			const int qx = g.ix(x - lx * (1.0 - f)), qy = g.iy(y - ly * (1.0 - f));
+			if (!g.inside(qx, qy)) continue;
+			const int q = int(g.index(qx, qy));
+			if (q == lastCell || uint32_t(q) == idx) continue;
+			lastCell = q;
+			const VoxelClass qc = m_class[size_t(q)];
+			if (qc == VoxelClass::Ground || qc == VoxelClass::Overhead) continue;
+			if (m_evidence[size_t(q)] <= 0.5f) stats.drop_ray_cells++;
+			put(uint32_t(q), p);
+		}
+	}
+}
+
+}  // namespace gam

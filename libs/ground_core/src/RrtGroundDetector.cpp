@@ -1,0 +1,354 @@
+#include "gam/RrtGroundDetector.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <nanoflann.hpp>
+#include <sstream>
+#include <stdexcept>
+
+namespace gam
+{
+namespace
+{
+// nanoflann adaptor: the (x, y) of the tree nodes.
+struct NodeCloud
+{
+	const std::vector<GroundNode>* nodes = nullptr;
+	size_t kdtree_get_point_count() const { return nodes->size(); }
+	float kdtree_get_pt(size_t i, size_t dim) const
+	{
+		return dim == 0 ? (*nodes)[i].x : (*nodes)[i].y;
+	}
+	template <class BBOX>
+	bool kdtree_get_bbox(BBOX&) const
+	{
+		return false;
+	}
+};
+using NodeIndex = nanoflann::KDTreeSingleIndexDynamicAdaptor<
+	nanoflann::L2_Simple_Adaptor<float, NodeCloud>, NodeCloud, 2, uint32_t>;
+
+void require(bool ok, const char* name, const std::string& range, double v)
+{
+	if (!ok)
+	{
+		std::ostringstream s;
+		s << name << " must be " << range << " (got " << v << ")";
+		throw std::invalid_argument(s.str());
+	}
+}
+}  // namespace
+
+void RrtGpdParams::validate() const
+{
+	require(iterations >= 1 && iterations <= 1000000, "K (iterations)", "in [1, 1000000]", iterations);
+	require(normal_threshold > 0 && normal_threshold <= 1, "N_th (normal_threshold)", "in (0, 1]", normal_threshold);
+	require(elevation_threshold > 0 && elevation_threshold < 10, "E_th (elevation_threshold)", "in (0, 10) m", elevation_threshold);
+	require(neighbourhood_x >= 1 && neighbourhood_x <= 31 && neighbourhood_x % 2 == 1, "s_x (neighbourhood_x)", "odd, in [1, 31]", neighbourhood_x);
+	require(neighbourhood_y >= 1 && neighbourhood_y <= 31 && neighbourhood_y % 2 == 1, "s_y (neighbourhood_y)", "odd, in [1, 31]", neighbourhood_y);
+	require(neighbourhood_x * neighbourhood_y >= 3, "s_x*s_y", ">= 3 cells", neighbourhood_x * neighbourhood_y);
+	require(expansion_distance > 0 && expansion_distance < 100, "d_n (expansion_distance)", "in (0, 100) m", expansion_distance);
+	require(max_cell_std > 0, "max_cell_std", "> 0 m", max_cell_std);
+	require(max_fit_rms > 0, "max_fit_rms", "> 0 m", max_fit_rms);
+	require(min_valid_cells >= 3 && min_valid_cells <= neighbourhood_x * neighbourhood_y, "min_valid_cells", "in [3, s_x*s_y]", min_valid_cells);
+	require(seed_search_radius > 0, "seed_search_radius", "> 0 m", seed_search_radius);
+	require(seed_height_tolerance > 0, "seed_height_tolerance", "> 0 m", seed_height_tolerance);
+	require(window_margin > 0, "window_margin", "> 0 m", window_margin);
+	require(min_nodes >= 3, "min_nodes", ">= 3", double(min_nodes));
+	require(ransac_iterations >= 1, "ransac_iterations", ">= 1", ransac_iterations);
+	require(ransac_inlier_distance > 0, "ransac_inlier_distance", "> 0 m", ransac_inlier_distance);
+	require(max_planes >= 1 && max_planes <= 8, "max_planes", "in [1, 8]", max_planes);
+}
+
+const char* GroundDetection::statusName(Status s)
+{
+	switch (s)
+	{
+		case Status::Ok: return "ok";
+		case Status::EmptyGrid: return "empty_grid";
+		case Status::NoValidSeed: return "no_valid_seed";
+		case Status::TooFewNodes: return "too_few_nodes";
+		case Status::NoConsensus: return "no_consensus";
+	}
+	return "unknown";
+}
+
+std::string GroundDetection::describe() const
+{
+	std::ostringstream s;
+	s << statusName(status) << ": " << nodes.size() << " nodes, " << planes.size() << " plane(s)";
+	if (!planes.empty())
+	{
+		const Plane& p = planes.front();
+		s << "; ground " << p.a << "x + " << p.b << "y + " << p.c << "z + " << p.d
+		  << " = 0 (tilt " << p.tiltAngle() * 180.0 / M_PI << " deg)";
+	}
+	return s.str();
+}
+
+bool RrtGroundDetector::cellHeight(const ElevationGrid& grid, int cx, int cy, float& z) const
+{
+	const ElevationCell& c = grid.cell(cx, cy);
+	if (c.count)
+	{
+		if (c.variance() > float(m_params.max_cell_std * m_params.max_cell_std)) return false;
+		z = c.mean();
+		return true;
+	}
+	z = c.z_idw;
+	return !std::isnan(z);
+}
+
+bool RrtGroundDetector::fitLocalPlane(
+	const ElevationGrid& grid, int cx, int cy, Plane& plane, double& rms) const
+{
+	const GridGeometry& g = grid.geometry();
+	const int hx = m_params.neighbourhood_x / 2, hy = m_params.neighbourhood_y / 2;
+	m_fitPts.clear();
+	for (int y = cy - hy; y <= cy + hy; y++)
+		for (int x = cx - hx; x <= cx + hx; x++)
+		{
+			float z;
+			if (!g.inside(x, y) || !cellHeight(grid, x, y, z)) continue;
+			// Coordinates relative to the centre cell keep the fit well conditioned.
+			m_fitPts.emplace_back((x - cx) * g.resolution, (y - cy) * g.resolution, double(z));
+		}
+	if (int(m_fitPts.size()) < m_params.min_valid_cells) return false;
+	const auto p = fitHeightPlaneLeastSquares(m_fitPts, &rms);
+	if (!p) return false;
+	// Move the plane from centre-relative to grid coordinates.
+	plane = Plane::fromNormalAndPoint(
+		p->normal(), Eigen::Vector3d(g.cx(cx), g.cy(cy), p->heightAt(0, 0)));
+	return true;
+}
+
+bool RrtGroundDetector::findSeed(
+	const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed)
+{
+	const GridGeometry& g = grid.geometry();
+	const int R = std::max(1, int(std::ceil(m_params.seed_search_radius / g.resolution)));
+	if (R != m_ringRadius)
+	{
+		// Cell offsets within the radius, nearest first.
+		m_ringOffsets.clear();
+		for (int dy = -R; dy <= R; dy++)
+			for (int dx = -R; dx <= R; dx++)
+				if (dx * dx + dy * dy <= R * R) m_ringOffsets.emplace_back(dx, dy);
+		std::stable_sort(
+			m_ringOffsets.begin(), m_ringOffsets.end(), [](const auto& a, const auto& b) {
+				return a.first * a.first + a.second * a.second <
+					   b.first * b.first + b.second * b.second;
+			});
+		m_ringRadius = R;
+	}
+	const int rx = g.ix(hint.x), ry = g.iy(hint.y);
+	for (const auto& [dx, dy] : m_ringOffsets)
+	{
+		const int cx = rx + dx, cy = ry + dy;
+		if (!g.inside(cx, cy)) continue;
+		const ElevationCell& c = grid.cell(cx, cy);
+		if (!c.count) continue;	 // the seed must be a real observation
+		float z;
+		if (!cellHeight(grid, cx, cy, z)) continue;
+		if (std::abs(z - hint.floor_z) > m_params.seed_height_tolerance) continue;
+		Plane pl;
+		double rms;
+		if (!fitLocalPlane(grid, cx, cy, pl, rms)) continue;
+		if (rms > m_params.max_fit_rms || pl.horizontalNormal() > m_params.normal_threshold)
+			continue;
+		seed.x = float(g.cx(cx));
+		seed.y = float(g.cy(cy));
+		seed.z = float(pl.heightAt(seed.x, seed.y));
+		seed.local = pl;
+		seed.parent = -1;
+		return true;
+	}
+	return false;
+}
+
+void RrtGroundDetector::detect(
+	const ElevationGrid& grid, const GroundSeedHint& hint, GroundDetection& out)
+{
+	m_params.validate();
+	out.nodes.clear();
+	out.planes.clear();
+	out.plane_support.clear();
+	out.iterations = 0;
+	if (grid.observedCount() == 0)
+	{
+		out.status = GroundDetection::Status::EmptyGrid;
+		return;
+	}
+	const GridGeometry& g = grid.geometry();
+	m_rng.seed(m_params.random_seed);
+
+	GroundNode seed;
+	if (!findSeed(grid, hint, seed))
+	{
+		out.status = GroundDetection::Status::NoValidSeed;
+		return;
+	}
+	if (m_hasNode.size() != g.cellCount()) m_hasNode.assign(g.cellCount(), 0);
+	for (uint32_t c : m_nodeCells) m_hasNode[c] = 0;
+	m_nodeCells.clear();
+
+	out.nodes.reserve(size_t(m_params.iterations) + 1);
+	out.nodes.push_back(seed);
+	{
+		const uint32_t c = uint32_t(g.index(g.ix(seed.x), g.iy(seed.y)));
+		m_hasNode[c] = 1;
+		m_nodeCells.push_back(c);
+	}
+	NodeCloud cloud{&out.nodes};
+	NodeIndex index(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10), size_t(m_params.iterations) + 2);
+	index.addPoints(0, 0);
+
+	// Sampling window: the nodes' bounding box grown by window_margin, clamped
+	// to the grid. It grows and drifts as the tree explores.
+	const double margin = m_params.window_margin;
+	double bx0 = seed.x, bx1 = seed.x, by0 = seed.y, by1 = seed.y;
+	std::uniform_real_distribution<double> U(0.0, 1.0);
+	const double dn = m_params.expansion_distance;
+
+	for (int k = 0; k < m_params.iterations; k++)
+	{
+		out.iterations = k + 1;
+		const double wx0 = std::max(g.x_min, bx0 - margin), wx1 = std::min(g.x_max(), bx1 + margin);
+		const double wy0 = std::max(g.y_min, by0 - margin), wy1 = std::min(g.y_max(), by1 + margin);
+		const double qx = wx0 + U(m_rng) * (wx1 - wx0), qy = wy0 + U(m_rng) * (wy1 - wy0);
+
+		uint32_t nearIdx = 0;
+		float nearD2 = 0;
+		const float q[2] = {float(qx), float(qy)};
+		nanoflann::KNNResultSet<float, uint32_t> rs(1);
+		rs.init(&nearIdx, &nearD2);
+		index.findNeighbors(rs, q, nanoflann::SearchParams());
+		const GroundNode near = out.nodes[nearIdx];	 // copy: push_back may reallocate
+
+		const double dist = std::sqrt(double(nearD2));
+		if (dist < 1e-9) continue;
+		const double s = std::min(1.0, dn / dist);
+		const double nx_ = near.x + (qx - near.x) * s, ny_ = near.y + (qy - near.y) * s;
+		const int cx = g.ix(nx_), cy = g.iy(ny_);
+		if (!g.inside(cx, cy)) continue;
+		const uint32_t cidx = uint32_t(g.index(cx, cy));
+		if (m_hasNode[cidx]) continue;
+		float z;
+		if (!cellHeight(grid, cx, cy, z)) continue;
+		const double px = g.cx(cx), py = g.cy(cy);
+		// Elevation test against the parent's local plane (lets the tree climb
+		// gentle ramps, stops it at steps, boxes and drops).
+		if (std::abs(double(z) - near.local.heightAt(px, py)) > m_params.elevation_threshold)
+			continue;
+		Plane pl;
+		double rms;
+		if (!fitLocalPlane(grid, cx, cy, pl, rms)) continue;
+		if (rms > m_params.max_fit_rms || pl.horizontalNormal() > m_params.normal_threshold)
+			continue;
+
+		GroundNode node;
+		node.x = float(px);
+		node.y = float(py);
+		node.z = float(pl.heightAt(px, py));
+		node.local = pl;
+		node.parent = int(nearIdx);
+		out.nodes.push_back(node);
+		m_hasNode[cidx] = 1;
+		m_nodeCells.push_back(cidx);
+		index.addPoints(out.nodes.size() - 1, out.nodes.size() - 1);
+		bx0 = std::min(bx0, px);
+		bx1 = std::max(bx1, px);
+		by0 = std::min(by0, py);
+		by1 = std::max(by1, py);
+	}
+
+	if (out.nodes.size() < m_params.min_nodes)
+	{
+		out.status = GroundDetection::Status::TooFewNodes;
+		return;
+	}
+	fitPlanes(out);
+	out.status = out.planes.empty() ? GroundDetection::Status::NoConsensus
+									: GroundDetection::Status::Ok;
+}
+
+void RrtGroundDetector::fitPlanes(GroundDetection& out)
+{
+	// RANSAC over the node centres gives the ground plane; further RANSAC rounds
+	// over the remaining nodes give ramps and other ground patches that the tree
+	// reached through small elevation changes.
+	std::vector<size_t> remaining(out.nodes.size());
+	for (size_t i = 0; i < remaining.size(); i++) remaining[i] = i;
+	std::vector<Eigen::Vector3d> pts;
+	RansacParams rp;
+	rp.iterations = m_params.ransac_iterations;
+	rp.inlier_distance = m_params.ransac_inlier_distance;
+	rp.max_horizontal_normal = m_params.normal_threshold;
+
+	for (int k = 0; k < m_params.max_planes && remaining.size() >= 3; k++)
+	{
+		rp.min_inliers = k == 0 ? std::max<size_t>(3, m_params.min_nodes / 2)
+								: m_params.min_nodes_per_extra_plane;
+		if (k > 0 && m_params.min_nodes_per_extra_plane == 0) break;
+		pts.clear();
+		for (size_t i : remaining) pts.emplace_back(out.nodes[i].x, out.nodes[i].y, out.nodes[i].z);
+		const auto r = fitPlaneRansac(pts, rp, m_rng);
+		if (!r) break;
+
+		Plane plane = r->plane;
+		// Nearly collinear node sets (a corridor crossed by one line of nodes)
+		// leave the roll about that line undetermined: take the mean of the
+		// inliers' local normals instead, which every node measured itself.
+		Eigen::Vector2d mean2 = Eigen::Vector2d::Zero();
+		for (size_t i : r->inliers) mean2 += pts[i].head<2>();
+		mean2 /= double(r->inliers.size());
+		Eigen::Matrix2d C = Eigen::Matrix2d::Zero();
+		for (size_t i : r->inliers)
+		{
+			const Eigen::Vector2d d = pts[i].head<2>() - mean2;
+			C += d * d.transpose();
+		}
+		C /= double(r->inliers.size());
+		const double minorStd = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(C).eigenvalues()(0)));
+		// An extra patch must be an area, not a line of nodes along the top of
+		// a cable protector or a kerb: those are obstacles, not ground.
+		const bool lineLike = minorStd < 0.25 * m_params.expansion_distance;
+		if (k > 0 && lineLike)
+		{
+			std::vector<uint8_t> drop(remaining.size(), 0);
+			for (size_t i : r->inliers) drop[i] = 1;
+			std::vector<size_t> rest;
+			for (size_t i = 0; i < remaining.size(); i++)
+				if (!drop[i]) rest.push_back(remaining[i]);
+			remaining.swap(rest);
+			continue;
+		}
+		if (minorStd < 0.5 * m_params.expansion_distance)
+		{
+			Eigen::Vector3d n = Eigen::Vector3d::Zero(), c = Eigen::Vector3d::Zero();
+			for (size_t i : r->inliers)
+			{
+				n += out.nodes[remaining[i]].local.normal();
+				c += pts[i];
+			}
+			plane = Plane::fromNormalAndPoint(n, c / double(r->inliers.size()));
+		}
+
+		const int id = int(out.planes.size());
+		out.planes.push_back(plane);
+		out.plane_support.push_back(r->inliers.size());
+		std::vector<uint8_t> isInlier(remaining.size(), 0);
+		for (size_t i : r->inliers)
+		{
+			isInlier[i] = 1;
+			out.nodes[remaining[i]].plane_id = id;
+		}
+		std::vector<size_t> rest;
+		for (size_t i = 0; i < remaining.size(); i++)
+			if (!isInlier[i]) rest.push_back(remaining[i]);
+		remaining.swap(rest);
+	}
+}
+
+}  // namespace gam

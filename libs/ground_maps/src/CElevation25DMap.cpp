@@ -1,0 +1,340 @@
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/img/CImage.h>
+#include <mrpt/img/color_maps.h>
+#include <mrpt/maps/CElevation25DMap.h>
+#include <mrpt/maps/gam_observation_adapters.h>
+#include <mrpt/opengl/CSetOfObjects.h>
+#include <mrpt/opengl/CSetOfTriangles.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+using namespace mrpt::maps;
+
+// .ini names: the RTTI name first (required), then the short alias.
+MAP_DEFINITION_REGISTER("mrpt::maps::CElevation25DMap,elevation25DMap", mrpt::maps::CElevation25DMap)
+IMPLEMENTS_SERIALIZABLE(CElevation25DMap, CMetricMap, mrpt::maps)
+
+CElevation25DMap::TMapDefinition::TMapDefinition() = default;
+
+void CElevation25DMap::TMapDefinition::loadFromConfigFile_map_specific(
+	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
+{
+	const std::string sC = sectionNamePrefix + "_creationOpts";
+	gam::ini::Fields f = {
+		{"min_x", &min_x, -1e5, 1e5, "grid left edge [m]"},
+		{"max_x", &max_x, -1e5, 1e5, "grid right edge [m]"},
+		{"min_y", &min_y, -1e5, 1e5, "grid bottom edge [m]"},
+		{"max_y", &max_y, -1e5, 1e5, "grid top edge [m]"},
+		{"resolution", &resolution, 1e-3, 100, "d_r, cell size [m]"}};
+	gam::ini::load(f, source, sC);
+	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
+}
+
+void CElevation25DMap::TMapDefinition::dumpToTextStream_map_specific(std::ostream& out) const
+{
+	out << "min_x=" << min_x << " max_x=" << max_x << " min_y=" << min_y << " max_y=" << max_y
+		<< " resolution=" << resolution << "\n";
+	insertionOpts.dumpToTextStream(out);
+}
+
+mrpt::maps::CMetricMap* CElevation25DMap::internal_CreateFromMapDefinition(const TMetricMapInitializer& _def)
+{
+	const auto& def = dynamic_cast<const CElevation25DMap::TMapDefinition&>(_def);
+	auto* m = new CElevation25DMap(def.min_x, def.max_x, def.min_y, def.max_y, def.resolution);
+	m->insertionOptions = def.insertionOpts;
+	return m;
+}
+
+// ---------------------------------------------------------------------------
+gam::ini::Fields CElevation25DMap::TInsertionOptions::fields()
+{
+	return {
+		{"z_min", &z_min, -1e4, 1e4, "points below this map-frame z are dropped [m]"},
+		{"z_max", &z_max, -1e4, 1e4, "points above this map-frame z are dropped [m]"},
+		{"min_range", &min_range, 0, 1e4, "closer returns are dropped [m]"},
+		{"max_range", &max_range, 0.01, 1e4, "farther returns are dropped [m]"},
+		{"decimation", &decimation, 1, 64, "use every n-th pixel row/column"},
+		{"outlier_filter", &outlier_filter, 0, 1, "3-sigma rule per cell and frame"},
+		{"outlier_sigmas", &outlier_sigmas, 0.5, 100, "k of the k-sigma rule"},
+		{"outlier_min_count", &outlier_min_count, 2, 1000000, "cells with fewer samples are not filtered"},
+		{"idw_radius", &idw_radius, 0, 50, "IDW window radius [cells], 0 = off"},
+		{"idw_power", &idw_power, 0.1, 10, "IDW distance exponent"},
+		{"idw_min_neighbours", &idw_min_neighbours, 1, 10000, "observed cells needed to interpolate"}};
+}
+
+void CElevation25DMap::TInsertionOptions::loadFromConfigFile(
+	const mrpt::config::CConfigFileBase& source, const std::string& section)
+{
+	gam::ini::load(fields(), source, section);
+	validate();
+}
+
+void CElevation25DMap::TInsertionOptions::saveToConfigFile(
+	mrpt::config::CConfigFileBase& target, const std::string& section) const
+{
+	gam::ini::save(const_cast<TInsertionOptions*>(this)->fields(), target, section);
+}
+
+void CElevation25DMap::TInsertionOptions::validate() const
+{
+	gam::ini::validate(const_cast<TInsertionOptions*>(this)->fields(), "CElevation25DMap insertOpts");
+	if (!(z_min < z_max))
+		throw std::invalid_argument("CElevation25DMap insertOpts: z_min must be < z_max");
+	if (!(min_range < max_range))
+		throw std::invalid_argument("CElevation25DMap insertOpts: min_range must be < max_range");
+}
+
+gam::OutlierFilterParams CElevation25DMap::TInsertionOptions::outlierParams() const
+{
+	gam::OutlierFilterParams p;
+	p.enabled = outlier_filter;
+	p.sigmas = outlier_sigmas;
+	p.min_count = uint32_t(outlier_min_count);
+	return p;
+}
+
+gam::IdwParams CElevation25DMap::TInsertionOptions::idwParams() const
+{
+	gam::IdwParams p;
+	p.radius_cells = idw_radius;
+	p.power = idw_power;
+	p.min_neighbours = idw_min_neighbours;
+	return p;
+}
+
+gam::ProjectionFilter CElevation25DMap::TInsertionOptions::projectionFilter() const
+{
+	gam::ProjectionFilter f;
+	f.min_range = min_range;
+	f.max_range = max_range;
+	f.z_min = z_min;
+	f.z_max = z_max;
+	f.decimation = decimation;
+	return f;
+}
+
+// ---------------------------------------------------------------------------
+CElevation25DMap::CElevation25DMap(
+	double x_min, double x_max, double y_min, double y_max, double resolution)
+{
+	setSize(x_min, x_max, y_min, y_max, resolution);
+}
+
+void CElevation25DMap::setSize(double x_min, double x_max, double y_min, double y_max, double res)
+{
+	if (!(res > 0)) throw std::invalid_argument("CElevation25DMap: resolution must be > 0");
+	if (!(x_max > x_min) || !(y_max > y_min))
+		throw std::invalid_argument("CElevation25DMap: need min_x < max_x and min_y < max_y");
+	gam::GridGeometry g;
+	g.x_min = x_min;
+	g.y_min = y_min;
+	g.resolution = res;
+	g.nx = int(std::lround((x_max - x_min) / res));
+	g.ny = int(std::lround((y_max - y_min) / res));
+	m_grid.resize(g);
+}
+
+void CElevation25DMap::internal_clear() { m_grid.clear(); }
+
+bool CElevation25DMap::isEmpty() const { return m_grid.observedCount() == 0; }
+
+void CElevation25DMap::finishInsertion()
+{
+	m_grid.insert(m_bins, insertionOptions.outlierParams());
+	m_bins.clear();
+	if (insertionOptions.idw_radius > 0) m_grid.interpolateIdw(insertionOptions.idwParams());
+}
+
+bool CElevation25DMap::internal_insertObservation(
+	const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose)
+{
+	insertionOptions.validate();
+	gam::mrpt_glue::BinningOptions bo;
+	bo.filter = insertionOptions.projectionFilter();
+	m_bins.clear();
+	size_t n = 0;
+	if (!gam::mrpt_glue::binObservation(
+			obs, robotPose ? *robotPose : mrpt::poses::CPose3D(), bo, m_grid, m_projector, m_bins, &n))
+		return false;
+	finishInsertion();
+	return n > 0;
+}
+
+size_t CElevation25DMap::insertPointCloud(const mrpt::maps::CPointsMap& pts, const mrpt::poses::CPose3D& pose)
+{
+	insertionOptions.validate();
+	m_bins.clear();
+	gam::ProjectionFilter f = insertionOptions.projectionFilter();
+	f.min_range = 0;  // ranges mean nothing for an already registered cloud
+	f.max_range = std::numeric_limits<float>::max();
+	gam::mrpt_glue::binPointCloud(pts, pose, f, m_grid, m_bins);
+	const size_t n = m_bins.size();
+	finishInsertion();
+	return n;
+}
+
+bool CElevation25DMap::getMinMaxHeight(float& zmin, float& zmax) const
+{
+	if (isEmpty()) return false;
+	zmin = std::numeric_limits<float>::infinity();
+	zmax = -zmin;
+	for (uint32_t i : m_grid.observedCells())
+	{
+		zmin = std::min(zmin, m_grid.cell(i).z_min);
+		zmax = std::max(zmax, m_grid.cell(i).z_max);
+	}
+	return true;
+}
+
+std::string CElevation25DMap::asString() const
+{
+	const auto& g = m_grid.geometry();
+	std::ostringstream s;
+	s << "CElevation25DMap " << g.nx << "x" << g.ny << " cells at " << g.resolution << " m, x["
+	  << g.x_min << "," << g.x_max() << "] y[" << g.y_min << "," << g.y_max() << "], "
+	  << m_grid.observedCount() << " observed cells";
+	return s.str();
+}
+
+// ---------------------------------------------------------------------------
+// Serialization: v0 = geometry, insertion options, generic params, observed cells.
+uint8_t CElevation25DMap::serializeGetVersion() const { return 0; }
+
+void CElevation25DMap::serializeTo(mrpt::serialization::CArchive& out) const
+{
+	const auto& g = m_grid.geometry();
+	out << g.x_min << g.y_min << g.resolution << int32_t(g.nx) << int32_t(g.ny);
+	const auto& o = insertionOptions;
+	out << o.z_min << o.z_max << o.min_range << o.max_range << int32_t(o.decimation)
+		<< o.outlier_filter << o.outlier_sigmas << int32_t(o.outlier_min_count)
+		<< int32_t(o.idw_radius) << o.idw_power << int32_t(o.idw_min_neighbours);
+	out << genericMapParams;
+	out << uint32_t(m_grid.observedCount());
+	for (uint32_t i : m_grid.observedCells())
+	{
+		const auto& c = m_grid.cell(i);
+		out << i << c.z_min << c.z_max << c.count << c.z_sum << c.z_sq_sum;
+	}
+}
+
+void CElevation25DMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version)
+{
+	switch (version)
+	{
+		case 0:
+		{
+			gam::GridGeometry g;
+			int32_t nx, ny;
+			in >> g.x_min >> g.y_min >> g.resolution >> nx >> ny;
+			g.nx = nx;
+			g.ny = ny;
+			m_grid.resize(g);  // validates
+			auto& o = insertionOptions;
+			int32_t dec, omc, idr, idn;
+			in >> o.z_min >> o.z_max >> o.min_range >> o.max_range >> dec >> o.outlier_filter >>
+				o.outlier_sigmas >> omc >> idr >> o.idw_power >> idn;
+			o.decimation = dec;
+			o.outlier_min_count = omc;
+			o.idw_radius = idr;
+			o.idw_min_neighbours = idn;
+			in >> genericMapParams;
+			uint32_t n;
+			in >> n;
+			if (n > g.cellCount())
+				throw std::runtime_error("CElevation25DMap: corrupt stream (more cells than the grid)");
+			gam::BinnedPoints none;
+			for (uint32_t k = 0; k < n; k++)
+			{
+				uint32_t i;
+				gam::ElevationCell c;
+				in >> i >> c.z_min >> c.z_max >> c.count >> c.z_sum >> c.z_sq_sum;
+				if (i >= g.cellCount() || c.count == 0)
+					throw std::runtime_error("CElevation25DMap: corrupt stream (bad cell)");
+				m_grid.restoreCell(i, c);
+			}
+			if (o.idw_radius > 0) m_grid.interpolateIdw(o.idwParams());
+		}
+		break;
+		default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+	}
+}
+
+// ---------------------------------------------------------------------------
+void CElevation25DMap::getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const
+{
+	if (!genericMapParams.enableSaveAs3DObject) return;
+	float zlo, zhi;
+	if (!getMinMaxHeight(zlo, zhi)) return;
+	const auto& g = m_grid.geometry();
+	const float span = std::max(1e-3f, zhi - zlo);
+	auto tris = mrpt::opengl::CSetOfTriangles::Create();
+	tris->setName("CElevation25DMap");
+	tris->reserve(m_grid.observedCount() * 10);
+	const float h = float(g.resolution) * 0.5f;
+	using P = mrpt::math::TPoint3Df;
+	for (uint32_t i : m_grid.observedCells())
+	{
+		const auto& c = m_grid.cell(i);
+		const float x = float(g.cx(int(i % uint32_t(g.nx)))), y = float(g.cy(int(i / uint32_t(g.nx))));
+		const float z0 = c.z_min, z1 = std::max(c.z_max, c.z_min + 0.25f * h);
+		const auto col = mrpt::img::colormap(mrpt::img::cmJET, (c.z_max - zlo) / span);
+		const P v[8] = {{x - h, y - h, z0}, {x + h, y - h, z0}, {x + h, y + h, z0}, {x - h, y + h, z0},
+						{x - h, y - h, z1}, {x + h, y - h, z1}, {x + h, y + h, z1}, {x - h, y + h, z1}};
+		// Top and the four sides of the column (the bottom is never seen).
+		static const int faces[5][4] = {{4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+		for (const auto& f : faces)
+			for (int t = 0; t < 2; t++)
+			{
+				mrpt::opengl::TTriangle tri(v[f[0]], v[f[1 + t]], v[f[2 + t]]);
+				tri.setColor(col);
+				tris->insertTriangle(tri);
+			}
+	}
+	outObj.insert(tris);
+}
+
+void CElevation25DMap::saveAsPngs(const std::string& prefix) const
+{
+	const auto& g = m_grid.geometry();
+	float zlo = 0, zhi = 1;
+	getMinMaxHeight(zlo, zhi);
+	float spanMax = 1e-3f;
+	uint32_t countMax = 1;
+	for (uint32_t i : m_grid.observedCells())
+	{
+		spanMax = std::max(spanMax, m_grid.cell(i).span());
+		countMax = std::max(countMax, m_grid.cell(i).count);
+	}
+	mrpt::img::CImage zmax(g.nx, g.ny, mrpt::img::CH_RGB), span(g.nx, g.ny, mrpt::img::CH_RGB),
+		count(g.nx, g.ny, mrpt::img::CH_RGB);
+	for (auto* im : {&zmax, &span, &count}) im->filledRectangle(0, 0, g.nx - 1, g.ny - 1, mrpt::img::TColor(0, 0, 0));
+	const float zr = std::max(1e-3f, zhi - zlo);
+	for (uint32_t i : m_grid.observedCells())
+	{
+		const auto& c = m_grid.cell(i);
+		const int cx = int(i % uint32_t(g.nx)), row = g.ny - 1 - int(i / uint32_t(g.nx));  // +y up
+		zmax.setPixel(cx, row, mrpt::img::colormap(mrpt::img::cmJET, (c.z_max - zlo) / zr));
+		span.setPixel(cx, row, mrpt::img::colormap(mrpt::img::cmHOT, c.span() / spanMax));
+		count.setPixel(
+			cx, row,
+			mrpt::img::colormap(mrpt::img::cmHOT, std::log1p(float(c.count)) / std::log1p(float(countMax))));
+	}
+	if (!zmax.saveToFile(prefix + "_zmax.png") || !span.saveToFile(prefix + "_span.png") ||
+		!count.saveToFile(prefix + "_count.png"))
+		throw std::runtime_error("CElevation25DMap: cannot write PNGs with prefix " + prefix);
+	std::ofstream f(prefix + "_scale.txt");
+	f << "# colour scales of " << prefix << "_*.png (one pixel per cell, +y up, black = no data)\n"
+	  << "zmax_png: jet colormap, blue = " << zlo << " m, red = " << zhi << " m\n"
+	  << "span_png: hot colormap, black = 0 m, white = " << spanMax << " m\n"
+	  << "count_png: hot colormap of log(1+N_z), white = " << countMax << " samples\n"
+	  << "grid: x_min " << g.x_min << " y_min " << g.y_min << " resolution " << g.resolution
+	  << " nx " << g.nx << " ny " << g.ny << "\n";
+}
+
+void CElevation25DMap::saveMetricMapRepresentationToFile(const std::string& prefix) const
+{
+	saveAsPngs(prefix);
+}
