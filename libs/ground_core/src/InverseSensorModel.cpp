@@ -28,6 +28,9 @@ void IsmParams::validate() const
 	require(K_n > 0, "K_n", "> 0", K_n);
 	require(std::isfinite(d_min), "d_min", "finite", d_min);
 	require(K_m >= 0 && K_m < 1, "K_m", "in [0, 1)", K_m);
+	require(depth_noise_c0 >= 0, "depth_noise_c0", ">= 0 m", depth_noise_c0);
+	require(depth_noise_c2 >= 0, "depth_noise_c2", ">= 0 1/m", depth_noise_c2);
+	require(noise_sigmas >= 0 && noise_sigmas <= 10, "noise_sigmas", "in [0, 10]", noise_sigmas);
 	require(robot_height > 0, "robot_height", "> 0 m", robot_height);
 	require(max_range > 0, "max_range", "> 0 m", max_range);
 	require(max_drop_ray_length >= 0, "max_drop_ray_length", ">= 0 m", max_drop_ray_length);
@@ -52,13 +55,25 @@ double groundProbability(double d, const IsmParams& p)
 }
 }  // namespace ism
 
+double InverseSensorModel::groundBand(
+	const Eigen::Vector3d& sensor, double h, double x, double y, double z) const
+{
+	if (m_params.noise_sigmas <= 0) return m_params.d_pth;
+	const double dx = x - sensor.x(), dy = y - sensor.y(), dz = z - sensor.z();
+	const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
+	if (r < 1e-3) return m_params.d_pth;
+	const double sd = m_params.depth_noise_c0 + m_params.depth_noise_c2 * r * r;
+	const double sinElev = std::clamp(std::abs(h) / r, 0.0, 1.0);
+	return m_params.d_pth + m_params.noise_sigmas * sd * sinElev;
+}
+
 VoxelClass InverseSensorModel::classify(
-	const ElevationCell& c, double x, double y, const Plane& pl, double& dMean) const
+	const ElevationCell& c, double x, double y, const Plane& pl, double band, double& dMean) const
 {
 	const double dTop = pl.signedDistance(x, y, c.z_max);
 	const double dBot = pl.signedDistance(x, y, c.z_min);
 	dMean = pl.signedDistance(x, y, c.mean());
-	const double th = m_params.d_pth;
+	const double th = band;
 	if (dBot > m_params.robot_height) return VoxelClass::Overhead;
 	if (dTop < -th) return VoxelClass::Drop;
 	if (dTop > th) return VoxelClass::Obstacle;
@@ -159,7 +174,9 @@ void InverseSensorModel::compute(
 		else
 		{
 			const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
-			cls = classify(c, x, y, choosePlane(det, c, x, y, block), dMean);
+			const Plane& pl = choosePlane(det, c, x, y, block);
+			const double hs = pl.signedDistance(sensor.x(), sensor.y(), sensor.z());
+			cls = classify(c, x, y, pl, groundBand(sensor, hs, x, y, c.mean()), dMean);
 		}
 		m_class[idx] = cls;
 		m_classCells.push_back(idx);

@@ -54,6 +54,7 @@ void RrtGpdParams::validate() const
 	require(min_valid_cells >= 3 && min_valid_cells <= neighbourhood_x * neighbourhood_y, "min_valid_cells", "in [3, s_x*s_y]", min_valid_cells);
 	require(seed_search_radius > 0, "seed_search_radius", "> 0 m", seed_search_radius);
 	require(seed_height_tolerance > 0, "seed_height_tolerance", "> 0 m", seed_height_tolerance);
+	require(seed_attempts >= 1 && seed_attempts <= 100, "seed_attempts", "in [1, 100]", seed_attempts);
 	require(window_margin > 0, "window_margin", "> 0 m", window_margin);
 	require(min_nodes >= 3, "min_nodes", ">= 3", double(min_nodes));
 	require(ransac_iterations >= 1, "ransac_iterations", ">= 1", ransac_iterations);
@@ -149,6 +150,7 @@ bool RrtGroundDetector::findSeed(
 		if (!g.inside(cx, cy)) continue;
 		const ElevationCell& c = grid.cell(cx, cy);
 		if (!c.count) continue;	 // the seed must be a real observation
+		if (!m_seedExcluded.empty() && m_seedExcluded[g.index(cx, cy)]) continue;
 		float z;
 		if (!cellHeight(grid, cx, cy, z)) continue;
 		if (std::abs(z - hint.floor_z) > m_params.seed_height_tolerance) continue;
@@ -183,12 +185,49 @@ void RrtGroundDetector::detect(
 	const GridGeometry& g = grid.geometry();
 	m_rng.seed(m_params.random_seed);
 
-	GroundNode seed;
-	if (!findSeed(grid, hint, seed))
+	m_seedExcluded.clear();
+	for (int attempt = 0; attempt < m_params.seed_attempts; attempt++)
 	{
-		out.status = GroundDetection::Status::NoValidSeed;
+		GroundNode seed;
+		if (!findSeed(grid, hint, seed))
+		{
+			if (attempt == 0)
+			{
+				out.status = GroundDetection::Status::NoValidSeed;
+				return;
+			}
+			break;
+		}
+		growTree(grid, seed, out);
+		if (out.nodes.size() >= m_params.min_nodes) break;
+		// The seed was a small flat patch (a box top, a shelf board): exclude
+		// the area the tree covered and try the next candidate.
+		if (m_seedExcluded.empty()) m_seedExcluded.assign(g.cellCount(), 0);
+		const int r = int(std::ceil(m_params.expansion_distance / g.resolution));
+		for (const GroundNode& n : out.nodes)
+		{
+			const int nx_ = g.ix(n.x), ny_ = g.iy(n.y);
+			for (int y = std::max(0, ny_ - r); y <= std::min(g.ny - 1, ny_ + r); y++)
+				for (int x = std::max(0, nx_ - r); x <= std::min(g.nx - 1, nx_ + r); x++)
+					m_seedExcluded[g.index(x, y)] = 1;
+		}
+	}
+
+	if (out.nodes.size() < m_params.min_nodes)
+	{
+		out.status = GroundDetection::Status::TooFewNodes;
 		return;
 	}
+	fitPlanes(out);
+	out.status = out.planes.empty() ? GroundDetection::Status::NoConsensus
+									: GroundDetection::Status::Ok;
+}
+
+void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out)
+{
+	const GridGeometry& g = grid.geometry();
+	out.nodes.clear();
+	out.iterations = 0;
 	if (m_hasNode.size() != g.cellCount()) m_hasNode.assign(g.cellCount(), 0);
 	for (uint32_t c : m_nodeCells) m_hasNode[c] = 0;
 	m_nodeCells.clear();
@@ -263,14 +302,6 @@ void RrtGroundDetector::detect(
 		by1 = std::max(by1, py);
 	}
 
-	if (out.nodes.size() < m_params.min_nodes)
-	{
-		out.status = GroundDetection::Status::TooFewNodes;
-		return;
-	}
-	fitPlanes(out);
-	out.status = out.planes.empty() ? GroundDetection::Status::NoConsensus
-									: GroundDetection::Status::Ok;
 }
 
 void RrtGroundDetector::fitPlanes(GroundDetection& out)

@@ -85,6 +85,7 @@ gam::ini::Fields CGroundAwareOccupancyGrid::TGroundAwareOptions::fields()
 		{"min_valid_cells", &min_valid_cells, 3, 961, "cells with a height a local fit needs"},
 		{"seed_search_radius", &seed_search_radius, 1e-3, 1000, "seed within this distance of the robot [m]"},
 		{"seed_height_tolerance", &seed_height_tolerance, 1e-3, 100, "seed height vs robot floor [m]"},
+		{"seed_attempts", &seed_attempts, 1, 100, "seeds tried when a tree stays too small"},
 		{"window_margin", &window_margin, 1e-3, 1000, "sampling window margin around the nodes [m]"},
 		{"min_nodes", &min_nodes, 3, 1000000, "fewer tree nodes = no ground"},
 		{"ransac_iterations", &ransac_iterations, 1, 1000000, "RANSAC iterations on the nodes"},
@@ -99,6 +100,9 @@ gam::ini::Fields CGroundAwareOccupancyGrid::TGroundAwareOptions::fields()
 		{"K_n", &K_n, 1e-12, 1e6, "density gain [m^3/point]"},
 		{"d_min", &d_min, -1e6, 1e6, "density sigmoid offset"},
 		{"K_m", &K_m, 0, 0.999, "obstacle gain"},
+		{"depth_noise_c0", &depth_noise_c0, 0, 1, "sensor depth noise sigma = c0 + c2 r^2: c0 [m]"},
+		{"depth_noise_c2", &depth_noise_c2, 0, 1, "c2 [1/m]"},
+		{"noise_sigmas", &noise_sigmas, 0, 10, "ground band = d_pth + noise_sigmas * vertical noise; 0 = fixed d_pth"},
 		{"robot_height", &robot_height, 1e-3, 100, "voxels entirely above this do not block [m]"},
 		{"drop_rays", &drop_rays, 0, 1, "mark cells where rays went below the ground"},
 		{"max_drop_ray_length", &max_drop_ray_length, 0, 100, "longest drop ray [m]"},
@@ -152,6 +156,7 @@ gam::RrtGpdParams CGroundAwareOccupancyGrid::TGroundAwareOptions::rrtParams() co
 	p.seed_search_radius = seed_search_radius;
 	p.seed_height_tolerance = seed_height_tolerance;
 	p.window_margin = window_margin;
+	p.seed_attempts = seed_attempts;
 	p.min_nodes = size_t(min_nodes);
 	p.ransac_iterations = ransac_iterations;
 	p.ransac_inlier_distance = ransac_inlier_distance;
@@ -170,6 +175,9 @@ gam::IsmParams CGroundAwareOccupancyGrid::TGroundAwareOptions::ismParams() const
 	p.K_n = K_n;
 	p.d_min = d_min;
 	p.K_m = K_m;
+	p.depth_noise_c0 = depth_noise_c0;
+	p.depth_noise_c2 = depth_noise_c2;
+	p.noise_sigmas = noise_sigmas;
 	p.robot_height = robot_height;
 	p.max_range = max_range;
 	p.drop_rays = drop_rays;

@@ -22,6 +22,14 @@ struct IsmParams
 	double K_n = 0.0005;  ///< density gain [m^3 per point]
 	double d_min = 3.0;	 ///< density offset of the sigmoid
 	double K_m = 0.8;  ///< obstacle gain: P(occ) = 0.5 + 0.5 * K_m * P_rho
+	/** Depth noise of the sensor, sigma(r) = c0 + c2 * r^2 [m] (defaults: the
+	 * Kinect v1 model of Nguyen et al. 2012; a Kinect One is better, so these
+	 * are conservative for it). Seen from the sensor at height h, a floor point
+	 * at range r moves vertically by sigma(r) * h / r, and the ground band
+	 * widens to d_pth + noise_sigmas * that: far floor is not an obstacle. */
+	double depth_noise_c0 = 0.0012;
+	double depth_noise_c2 = 0.0019;
+	double noise_sigmas = 3.0;	///< 0 = the paper's fixed d_pth
 	/** Voxels whose bottom is more than this above the ground do not block
 	 * (ceiling, door frames, beams above the robot). [m] */
 	double robot_height = 1.8;
@@ -98,7 +106,10 @@ class InverseSensorModel
 	const std::vector<VoxelClass>& classes() const { return m_class; }
 
 	/** Classification of one voxel against one plane (exposed for tests). */
-	VoxelClass classify(const ElevationCell& c, double x, double y, const Plane& pl, double& dMean) const;
+	VoxelClass classify(
+		const ElevationCell& c, double x, double y, const Plane& pl, double band, double& dMean) const;
+	/** Half-width of the ground band for a voxel at (x, y, z) seen from `sensor`. */
+	double groundBand(const Eigen::Vector3d& sensor, double sensorHeight, double x, double y, double z) const;
 
    private:
 	void put(uint32_t cell, float p);

@@ -36,8 +36,12 @@ struct RrtGpdParams
 	int min_valid_cells = 5;
 	/** The seed is the valid cell nearest to the robot within this radius [m]
 	 * whose height is within seed_height_tolerance of the expected floor. */
-	double seed_search_radius = 3.0;
+	double seed_search_radius = 5.0;
 	double seed_height_tolerance = 0.3;
+	/** A tree that stays below min_nodes (it started on a box top or a shelf
+	 * board) is discarded and regrown from the next seed candidate outside
+	 * it, up to this many times. */
+	int seed_attempts = 3;
 	/** Margin [m] added around the explored nodes to form the sampling window. */
 	double window_margin = 1.0;
 	/** Fewer nodes than this: "too few nodes", no plane. */
@@ -110,6 +114,7 @@ class RrtGroundDetector
    private:
 	bool cellHeight(const ElevationGrid& grid, int cx, int cy, float& z) const;
 	bool findSeed(const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed);
+	void growTree(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
 	void fitPlanes(GroundDetection& out);
 
 	RrtGpdParams m_params;
@@ -119,6 +124,7 @@ class RrtGroundDetector
 	std::vector<uint32_t> m_nodeCells;
 	mutable std::vector<Eigen::Vector3d> m_fitPts;
 	std::vector<std::pair<int, int>> m_ringOffsets;
+	std::vector<uint8_t> m_seedExcluded;
 	int m_ringRadius = -1;
 };
 

@@ -73,13 +73,15 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		double d_n = 0.4;
 		double max_cell_std = 0.05, max_fit_rms = 0.025;
 		int min_valid_cells = 5;
-		double seed_search_radius = 3.0, seed_height_tolerance = 0.3, window_margin = 1.0;
+		double seed_search_radius = 5.0, seed_height_tolerance = 0.3, window_margin = 1.0;
+		int seed_attempts = 3;
 		int min_nodes = 8, ransac_iterations = 100;
 		double ransac_inlier_distance = 0.025;
 		int min_nodes_per_extra_plane = 3, max_planes = 3;
 		int random_seed = 1;
 		// Inverse sensor model
 		double d_pth = 0.03, K_g = 0.3, sigma2 = 0.02, K_n = 0.0005, d_min = 3.0, K_m = 0.8;
+		double depth_noise_c0 = 0.0012, depth_noise_c2 = 0.0019, noise_sigmas = 3.0;
 		double robot_height = 1.8;
 		bool drop_rays = true;
 		double max_drop_ray_length = 2.0;
