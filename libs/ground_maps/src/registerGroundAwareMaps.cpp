@@ -1,6 +1,8 @@
 #include <mrpt/core/initializer.h>
 #include <mrpt/maps/CElevation25DMap.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
+#include <mrpt/maps/CHeightBandOccupancyGrid.h>
+#include <mrpt/maps/COctoMapGrid2D.h>
 #include <mrpt/maps/registerGroundAwareMaps.h>
 #include <mrpt/rtti/CObject.h>
 
@@ -11,6 +13,8 @@ MRPT_INITIALIZER(registerAllClasses_ground_aware_maps)
 {
 	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CElevation25DMap));
 	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CGroundAwareOccupancyGrid));
+	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CHeightBandOccupancyGrid));
+	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::COctoMapGrid2D));
 }
 
 void mrpt::maps::registerGroundAwareMaps()
@@ -18,4 +22,6 @@ void mrpt::maps::registerGroundAwareMaps()
 	// Idempotent: registerClass ignores classes it already knows.
 	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CElevation25DMap));
 	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CGroundAwareOccupancyGrid));
+	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CHeightBandOccupancyGrid));
+	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::COctoMapGrid2D));
 }

@@ -1,0 +1,186 @@
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/maps/CHeightBandOccupancyGrid.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/T3DPointsTo2DScanParams.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <sstream>
+#include <stdexcept>
+
+using namespace mrpt::maps;
+
+MAP_DEFINITION_REGISTER(
+	"mrpt::maps::CHeightBandOccupancyGrid,heightBandGrid", mrpt::maps::CHeightBandOccupancyGrid)
+IMPLEMENTS_SERIALIZABLE(CHeightBandOccupancyGrid, COccupancyGridMap2D, mrpt::maps)
+
+CHeightBandOccupancyGrid::TMapDefinition::TMapDefinition()
+{
+	// See the class comment: converted depth scans need these.
+	insertionOpts.considerInvalidRangesAsFreeSpace = false;
+	insertionOpts.horizontalTolerance = mrpt::DEG2RAD(10.0f);
+}
+
+void CHeightBandOccupancyGrid::TMapDefinition::loadFromConfigFile_map_specific(
+	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
+{
+	const std::string sC = sectionNamePrefix + "_creationOpts";
+	gam::ini::Fields f = {
+		{"min_x", &min_x, -1e5, 1e5, "grid left edge [m]"},
+		{"max_x", &max_x, -1e5, 1e5, "grid right edge [m]"},
+		{"min_y", &min_y, -1e5, 1e5, "grid bottom edge [m]"},
+		{"max_y", &max_y, -1e5, 1e5, "grid top edge [m]"},
+		{"resolution", &resolution, 1e-3, 100, "cell size [m]"}};
+	gam::ini::load(f, source, sC);
+	if (!(min_x < max_x) || !(min_y < max_y))
+		throw std::invalid_argument("[" + sC + "] needs min_x < max_x and min_y < max_y");
+	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
+	likelihoodOpts.loadFromConfigFile(source, sectionNamePrefix + "_likelihoodOpts");
+	bandOpts.loadFromConfigFile(source, sectionNamePrefix + "_bandOpts");
+}
+
+void CHeightBandOccupancyGrid::TMapDefinition::dumpToTextStream_map_specific(std::ostream& out) const
+{
+	out << "min_x=" << min_x << " max_x=" << max_x << " min_y=" << min_y << " max_y=" << max_y
+		<< " resolution=" << resolution << "\n";
+	insertionOpts.dumpToTextStream(out);
+	likelihoodOpts.dumpToTextStream(out);
+	bandOpts.dumpToTextStream(out);
+}
+
+mrpt::maps::CMetricMap* CHeightBandOccupancyGrid::internal_CreateFromMapDefinition(
+	const TMetricMapInitializer& _def)
+{
+	const auto& def = dynamic_cast<const CHeightBandOccupancyGrid::TMapDefinition&>(_def);
+	auto* m = new CHeightBandOccupancyGrid(def.min_x, def.max_x, def.min_y, def.max_y, def.resolution);
+	m->insertionOptions = def.insertionOpts;
+	m->likelihoodOptions = def.likelihoodOpts;
+	m->bandOptions = def.bandOpts;
+	return m;
+}
+
+// ---------------------------------------------------------------------------
+gam::ini::Fields CHeightBandOccupancyGrid::THeightBandOptions::fields()
+{
+	return {
+		{"z_min", &z_min, -100, 100, "lowest robot-frame z turned into the virtual scan [m]"},
+		{"z_max", &z_max, -100, 100, "highest robot-frame z turned into the virtual scan [m]"},
+		{"oversampling_ratio", &oversampling_ratio, 0.1, 10, "virtual rays per depth-image column"}};
+}
+
+void CHeightBandOccupancyGrid::THeightBandOptions::loadFromConfigFile(
+	const mrpt::config::CConfigFileBase& source, const std::string& section)
+{
+	gam::ini::load(fields(), source, section);
+	try
+	{
+		validate();
+	}
+	catch (const std::invalid_argument& e)
+	{
+		throw std::invalid_argument("[" + section + "] " + e.what());
+	}
+}
+
+void CHeightBandOccupancyGrid::THeightBandOptions::saveToConfigFile(
+	mrpt::config::CConfigFileBase& target, const std::string& section) const
+{
+	gam::ini::save(const_cast<THeightBandOptions*>(this)->fields(), target, section);
+}
+
+void CHeightBandOccupancyGrid::THeightBandOptions::validate() const
+{
+	gam::ini::validate(const_cast<THeightBandOptions*>(this)->fields(), "bandOpts");
+	if (!(z_min < z_max)) throw std::invalid_argument("bandOpts: z_min must be < z_max");
+}
+
+// ---------------------------------------------------------------------------
+CHeightBandOccupancyGrid::CHeightBandOccupancyGrid(
+	float min_x, float max_x, float min_y, float max_y, float resolution)
+	: COccupancyGridMap2D(min_x, max_x, min_y, max_y, resolution)
+{
+	insertionOptions.considerInvalidRangesAsFreeSpace = false;
+	insertionOptions.horizontalTolerance = mrpt::DEG2RAD(10.0f);
+}
+
+std::string CHeightBandOccupancyGrid::asString() const
+{
+	std::ostringstream s;
+	s << "CHeightBandOccupancyGrid " << getSizeX() << "x" << getSizeY() << " cells at "
+	  << getResolution() << " m, band z[" << bandOptions.z_min << "," << bandOptions.z_max << "]";
+	return s.str();
+}
+
+bool CHeightBandOccupancyGrid::internal_insertObservation(
+	const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose)
+{
+	using namespace mrpt::obs;
+	if (IS_CLASS(obs, CObservation3DRangeScan))
+	{
+		// convertTo2DScan() is non-const only because it caches lookup tables.
+		auto& o3 = const_cast<CObservation3DRangeScan&>(dynamic_cast<const CObservation3DRangeScan&>(obs));
+		if (!o3.hasRangeImage || o3.rangeImage.cols() == 0) return false;
+		T3DPointsTo2DScanParams sp;
+		sp.sensorLabel = o3.sensorLabel;
+		sp.use_origin_sensor_pose = true;
+		sp.z_min = bandOptions.z_min;
+		sp.z_max = bandOptions.z_max;
+		sp.oversampling_ratio = bandOptions.oversampling_ratio;
+		m_lastScan = CObservation2DRangeScan();
+		o3.convertTo2DScan(m_lastScan, sp);
+		m_hasLastScan = true;
+		if (m_lastScan.getScanSize() == 0) return false;
+		return COccupancyGridMap2D::internal_insertObservation(m_lastScan, robotPose);
+	}
+	return COccupancyGridMap2D::internal_insertObservation(obs, robotPose);
+}
+
+// ---------------------------------------------------------------------------
+// v0 = base grid (with its own version) + bandOptions as (key, value) pairs.
+uint8_t CHeightBandOccupancyGrid::serializeGetVersion() const { return 0; }
+
+void CHeightBandOccupancyGrid::serializeTo(mrpt::serialization::CArchive& out) const
+{
+	out << COccupancyGridMap2D::serializeGetVersion();
+	COccupancyGridMap2D::serializeTo(out);
+	const auto f = const_cast<THeightBandOptions&>(bandOptions).fields();
+	out << uint32_t(f.size());
+	for (const auto& fl : f) out << fl.key << std::visit([](auto* p) { return double(*p); }, fl.var);
+}
+
+void CHeightBandOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version)
+{
+	switch (version)
+	{
+		case 0:
+		{
+			uint8_t baseVer;
+			in >> baseVer;
+			COccupancyGridMap2D::serializeFrom(in, baseVer);
+			auto f = bandOptions.fields();
+			uint32_t n;
+			in >> n;
+			if (n > 10000) throw std::runtime_error("CHeightBandOccupancyGrid: corrupt stream");
+			for (uint32_t i = 0; i < n; i++)
+			{
+				std::string key;
+				double v;
+				in >> key >> v;
+				for (auto& fl : f)
+					if (fl.key == key)
+						std::visit(
+							[v](auto* p) {
+								using T = std::remove_pointer_t<decltype(p)>;
+								if constexpr (std::is_same_v<T, bool>)
+									*p = v != 0;
+								else
+									*p = T(v);
+							},
+							fl.var);
+			}
+			m_hasLastScan = false;
+		}
+		break;
+		default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+	}
+}
