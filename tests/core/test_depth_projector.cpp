@@ -1,0 +1,488 @@
+// Ground-aware mapping for MRPT
+// DepthProjector against synthetic range images of known geometry.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "gam/DepthProjector.h"
+#include "test_helpers.h"
+
+using namespace gam;
+using gamtest::deg2rad;
+using gamtest::makeGeometry;
+
+namespace
+{
+constexpr int W = 64, H = 48;
+
+PinholeIntrinsics camera()
+{
+	PinholeIntrinsics K;
+	K.width = W;
+	K.height = H;
+	K.fx = 50;
+	K.fy = 50;
+	K.cx = 31.5;
+	K.cy = 23.5;
+	return K;
+}
+
+struct Image
+{
+	std::vector<uint16_t> px;
+	int rows = H, cols = W;
+	size_t stride = W;
+	Image(int r = H, int c = W, size_t s = W) : px(size_t(r) * s, 0), rows(r), cols(c), stride(s) {}
+	uint16_t& at(int r, int c) { return px[size_t(r) * stride + size_t(c)]; }
+	RangeImageView view(bool isDepth = true, float units = 0.001f) const
+	{
+		RangeImageView v;
+		v.data = px.data();
+		v.rows = rows;
+		v.cols = cols;
+		v.stride = stride;
+		v.units = units;
+		v.is_depth = isDepth;
+		return v;
+	}
+};
+
+/** Ray of pixel (r, c) in the sensor frame, x = 1 (MRPT convention). */
+Eigen::Vector3d pixelRay(const PinholeIntrinsics& K, int r, int c)
+{
+	return {1.0, (K.cx - c) / K.fx, (K.cy - r) / K.fy};
+}
+
+RigidTransform pose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t)
+{
+	RigidTransform T;
+	T.R = R.cast<float>();
+	T.t = t.cast<float>();
+	return T;
+}
+Eigen::Matrix3d pitchDown(double deg)
+{
+	// Rotation about +Y by +deg maps +X to (cos, 0, -sin): looking down.
+	return Eigen::AngleAxisd(deg2rad(deg), Eigen::Vector3d::UnitY()).toRotationMatrix();
+}
+Eigen::Matrix3d yaw(double deg)
+{
+	return Eigen::AngleAxisd(deg2rad(deg), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+}
+
+/** The cell `idx` must contain (x, y), up to a tolerance for float rounding at
+ * the cell borders. */
+void expectInCell(const GridGeometry& g, uint32_t idx, double x, double y, double tol = 1e-4)
+{
+	const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
+	const double x0 = g.x_min + cx * g.resolution, y0 = g.y_min + cy * g.resolution;
+	EXPECT_GE(x, x0 - tol) << "cell " << cx << "," << cy;
+	EXPECT_LT(x, x0 + g.resolution + tol) << "cell " << cx << "," << cy;
+	EXPECT_GE(y, y0 - tol) << "cell " << cx << "," << cy;
+	EXPECT_LT(y, y0 + g.resolution + tol) << "cell " << cx << "," << cy;
+}
+
+/** Projects each listed pixel alone (every 5th row and column) and compares it
+ * with the analytic point R * (D * ray) + t. */
+void checkPixelsOneByOne(
+	const Image& img, bool isDepth, const RigidTransform& T, const Eigen::Matrix3d& R,
+	const Eigen::Vector3d& t, const ElevationGrid& grid, int* checked)
+{
+	const PinholeIntrinsics K = camera();
+	DepthProjector proj;
+	ProjectionFilter f;
+	f.max_range = 60;
+	for (int r = 0; r < H; r += 5)
+		for (int c = 0; c < W; c += 5)
+		{
+			const uint16_t raw = img.px[size_t(r) * img.stride + size_t(c)];
+			if (!raw) continue;
+			Image one;
+			one.at(r, c) = raw;
+			BinnedPoints out;
+			ASSERT_EQ(proj.project(one.view(isDepth), K, T, f, grid, out), 1u) << r << "," << c;
+			ASSERT_EQ(out.size(), 1u);
+			const Eigen::Vector3d ray = pixelRay(K, r, c);
+			const double v = raw * 0.001;
+			const double D = isDepth ? v : v / ray.norm();
+			const Eigen::Vector3d P = R * (D * ray) + t;
+			expectInCell(grid.geometry(), out.cell[0], P.x(), P.y());
+			EXPECT_NEAR(out.z[0], P.z(), 1e-4) << r << "," << c;
+			++*checked;
+		}
+}
+
+uint16_t toRaw(double metres) { return uint16_t(std::lround(metres * 1000.0)); }
+
+/** Depth image of the wall x = X (sensor at the origin of its frame). */
+Image wallDepthImage(double X)
+{
+	Image img;
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++) img.at(r, c) = toRaw(X);
+	return img;
+}
+
+}  // namespace
+
+TEST(DepthProjector, RayLutFollowsMrptConvention)
+{
+	const PinholeIntrinsics K = camera();
+	DepthProjector proj;
+	ElevationGrid grid;
+	BinnedPoints out;
+	Image img;
+	proj.project(img.view(), K, RigidTransform{}, ProjectionFilter{}, grid, out);
+	ASSERT_EQ(proj.rayLut().size(), size_t(W * H));
+	for (int r : {0, 10, 47})
+		for (int c : {0, 31, 63})
+		{
+			const auto& k = proj.rayLut()[size_t(r) * W + size_t(c)];
+			EXPECT_NEAR(k.x(), (31.5 - c) / 50.0, 1e-6);
+			EXPECT_NEAR(k.y(), (23.5 - r) / 50.0, 1e-6);
+		}
+	EXPECT_EQ(out.size(), 0u);	// an all-zero image bins nothing
+}
+
+TEST(DepthProjector, WallAtThreeMetresLandsInItsColumn)
+{
+	// Sensor at (0, 0, 0.5) looking along +X; wall x = 3.02 (column 160 of a
+	// grid from -5 with 5 cm cells: (3.02 + 5) / 0.05 = 160.4).
+	const Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+	const Eigen::Vector3d t(0, 0, 0.5);
+	const RigidTransform T = pose(R, t);
+	ElevationGrid grid;	 // -5..5, 0.05
+	const Image img = wallDepthImage(3.02);
+
+	DepthProjector proj;
+	BinnedPoints out;
+	EXPECT_EQ(proj.project(img.view(), camera(), T, ProjectionFilter{}, grid, out), size_t(W * H));
+	ASSERT_EQ(out.size(), size_t(W * H));
+	const int col = int(std::floor((3.02 + 5.0) / 0.05));
+	ASSERT_EQ(col, 160);
+	double zmin = 1e9, zmax = -1e9;
+	for (size_t i = 0; i < out.size(); i++)
+	{
+		EXPECT_EQ(int(out.cell[i] % 200u), col);
+		zmin = std::min(zmin, double(out.z[i]));
+		zmax = std::max(zmax, double(out.z[i]));
+	}
+	// Heights of the top and bottom rows: 0.5 + 3.02 * (23.5 - r) / 50.
+	EXPECT_NEAR(zmax, 0.5 + 3.02 * 23.5 / 50, 1e-4);
+	EXPECT_NEAR(zmin, 0.5 + 3.02 * (23.5 - 47) / 50, 1e-4);
+
+	// Into the grid: pixel column c sees y = 3.02 * (31.5 - c) / 50 (6 cm
+	// apart, so some 5 cm cells in between stay empty); 48 points each.
+	gamtest::insertAll(grid, out);
+	const GridGeometry& g = grid.geometry();
+	std::vector<int> expectedCount(size_t(g.ny), 0);
+	for (int c = 0; c < W; c++)
+	{
+		const double y = 3.02 * (31.5 - c) / 50, fy = (y + 5) / 0.05;
+		ASSERT_GT(std::abs(fy - std::round(fy)), 0.01);	// no pixel on a cell border
+		expectedCount[size_t(std::floor(fy))] += H;
+	}
+	for (int cy = 0; cy < g.ny; cy++)
+		for (int cx = 0; cx < g.nx; cx++)
+		{
+			const ElevationCell& c = grid.cell(cx, cy);
+			if (cx != col)
+				ASSERT_FALSE(c.observed()) << cx << "," << cy;
+			else
+				EXPECT_EQ(int(c.count), expectedCount[size_t(cy)]) << "y=" << g.cy(cy);
+		}
+
+	int checked = 0;
+	checkPixelsOneByOne(img, true, T, R, t, grid, &checked);
+	EXPECT_GT(checked, 100);
+}
+
+TEST(DepthProjector, YawedSensorSeesWallInItsRow)
+{
+	// Sensor at (1, 2, 0.5) yawed +90 deg (looking along +Y): the wall at
+	// depth 2.02 is the line y = 4.02, row floor((4.02 + 5) / 0.05) = 180.
+	const Eigen::Matrix3d R = yaw(90);
+	const Eigen::Vector3d t(1, 2, 0.5);
+	const RigidTransform T = pose(R, t);
+	ElevationGrid grid;
+	const Image img = wallDepthImage(2.02);
+	DepthProjector proj;
+	BinnedPoints out;
+	EXPECT_EQ(proj.project(img.view(), camera(), T, ProjectionFilter{}, grid, out), size_t(W * H));
+	for (size_t i = 0; i < out.size(); i++) EXPECT_EQ(int(out.cell[i] / 200u), 180);
+	// Pixel column 0 looks left of the optical axis: +Y of the sensor = -X of
+	// the grid, so x = 1 - 2.02 * 31.5 / 50.
+	Image one;
+	one.at(23, 0) = toRaw(2.02);
+	out.clear();
+	ASSERT_EQ(proj.project(one.view(), camera(), T, ProjectionFilter{}, grid, out), 1u);
+	expectInCell(grid.geometry(), out.cell[0], 1 - 2.02 * 31.5 / 50, 4.02);
+	int checked = 0;
+	checkPixelsOneByOne(img, true, T, R, t, grid, &checked);
+	EXPECT_GT(checked, 100);
+}
+
+TEST(DepthProjector, FloorFromPitchedCameraLandsAtZeroHeight)
+{
+	// Camera 1 m above the floor, pitched 45 deg down: every pixel sees the
+	// floor z = 0 at D = 1 / -(R * ray).z along the sensor X axis.
+	const Eigen::Matrix3d R = pitchDown(45);
+	const Eigen::Vector3d t(0.3, -0.2, 1.0);
+	const RigidTransform T = pose(R, t);
+	const PinholeIntrinsics K = camera();
+	Image img;
+	double farthest = 0;
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+		{
+			const Eigen::Vector3d w = R * pixelRay(K, r, c);
+			ASSERT_LT(w.z(), -0.1);
+			const double D = 1.0 / -w.z();
+			farthest = std::max(farthest, D);
+			img.at(r, c) = toRaw(D);
+		}
+	ASSERT_LT(farthest, 5.0);  // all within the default max range
+
+	ElevationGrid grid;
+	DepthProjector proj;
+	BinnedPoints out;
+	EXPECT_EQ(proj.project(img.view(), K, T, ProjectionFilter{}, grid, out), size_t(W * H));
+	// Depth quantization is 0.5 mm along X: |dz| <= 0.5 mm * |w.z| / 1 < 1 mm.
+	for (float z : out.z) EXPECT_NEAR(z, 0.0, 1e-3);
+	gamtest::insertAll(grid, out);
+	for (uint32_t idx : grid.observedCells()) EXPECT_NEAR(grid.cell(idx).mean(), 0.0, 1e-3);
+	// Nearest floor point: bottom row, centre column.
+	{
+		const Eigen::Vector3d w = R * pixelRay(K, H - 1, 31);
+		const Eigen::Vector3d P = t + (1.0 / -w.z()) * w;
+		EXPECT_TRUE(grid.cell(grid.geometry().ix(P.x()), grid.geometry().iy(P.y())).observed());
+		// Nothing is closer to the camera than that row, in x.
+		for (uint32_t idx : grid.observedCells())
+			EXPECT_GE(grid.geometry().cx(int(idx % 200u)), P.x() - 0.06);
+	}
+	int checked = 0;
+	checkPixelsOneByOne(img, true, T, R, t, grid, &checked);
+	EXPECT_GT(checked, 100);
+}
+
+TEST(DepthProjector, RangeModeUsesEuclideanRange)
+{
+	// Same wall x = 3.02, but the image stores the range along each ray.
+	const Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+	const Eigen::Vector3d t(0, 0, 0.5);
+	const RigidTransform T = pose(R, t);
+	const PinholeIntrinsics K = camera();
+	Image img;
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++) img.at(r, c) = toRaw(3.02 * pixelRay(K, r, c).norm());
+	ElevationGrid grid;
+	DepthProjector proj;
+	BinnedPoints out;
+	ProjectionFilter f;
+	f.max_range = 10;
+	EXPECT_EQ(proj.project(img.view(false), K, T, f, grid, out), size_t(W * H));
+	for (size_t i = 0; i < out.size(); i++) EXPECT_EQ(int(out.cell[i] % 200u), 160);
+	int checked = 0;
+	checkPixelsOneByOne(img, false, T, R, t, grid, &checked);
+	EXPECT_GT(checked, 100);
+
+	// Read as depth, the corner pixel would land at x = range, not at 3.02.
+	Image one;
+	one.at(0, 0) = img.at(0, 0);
+	out.clear();
+	ASSERT_EQ(proj.project(one.view(true), K, T, f, grid, out), 1u);
+	const double xr = 3.02 * pixelRay(K, 0, 0).norm();	// 3.84 m
+	EXPECT_EQ(int(out.cell[0] % 200u), int(std::floor((xr + 5) / 0.05)));
+
+	// Range limits apply to the range along the ray in this mode: a wall at
+	// x = 3.5 has ranges 3.5 |ray| in [3.5, 4.55]; max_range 4 keeps the pixels
+	// with |ray| <= 4 / 3.5.
+	Image w35;
+	size_t expected = 0;
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+		{
+			const double range = 3.5 * pixelRay(K, r, c).norm();
+			w35.at(r, c) = toRaw(range);
+			if (w35.at(r, c) * 0.001 <= 4.0) expected++;
+		}
+	ASSERT_GT(expected, 100u);
+	ASSERT_LT(expected, size_t(W * H));
+	f.max_range = 4.0;
+	out.clear();
+	EXPECT_EQ(proj.project(w35.view(false), K, T, f, grid, out), expected);
+	// As a depth image, every pixel is at 3.5..4.55 "depth": only raw <= 4000.
+}
+
+TEST(DepthProjector, DecimationUsesEveryNthRowAndColumn)
+{
+	const RigidTransform T = pose(Eigen::Matrix3d::Identity(), {0, 0, 0.5});
+	ElevationGrid grid;
+	const Image img = wallDepthImage(3.02);
+	DepthProjector proj;
+	BinnedPoints out;
+	ProjectionFilter f;
+	f.decimation = 2;
+	EXPECT_EQ(proj.project(img.view(), camera(), T, f, grid, out), size_t(24 * 32));
+	// Only even rows: z = 0.5 + 3.02 * (23.5 - r) / 50 with r even.
+	for (float z : out.z)
+	{
+		const double r = 23.5 - (z - 0.5) * 50 / 3.02;
+		const double nearest = std::round(r);
+		EXPECT_NEAR(r, nearest, 0.01);
+		EXPECT_EQ(int(nearest) % 2, 0) << "row " << nearest;
+	}
+	f.decimation = 3;
+	out.clear();
+	EXPECT_EQ(proj.project(img.view(), camera(), T, f, grid, out), size_t(16 * 22));
+	f.decimation = 0;  // treated as 1
+	out.clear();
+	EXPECT_EQ(proj.project(img.view(), camera(), T, f, grid, out), size_t(W * H));
+
+	// A lone pixel at an odd row is skipped with decimation 2, at (2, 4) kept.
+	f.decimation = 2;
+	Image one;
+	one.at(1, 1) = 3020;
+	out.clear();
+	EXPECT_EQ(proj.project(one.view(), camera(), T, f, grid, out), 0u);
+	one.at(1, 1) = 0;
+	one.at(2, 4) = 3020;
+	EXPECT_EQ(proj.project(one.view(), camera(), T, f, grid, out), 1u);
+}
+
+TEST(DepthProjector, HeightBandAndRangeLimits)
+{
+	const RigidTransform T = pose(Eigen::Matrix3d::Identity(), {0, 0, 0.5});
+	ElevationGrid grid;
+	DepthProjector proj;
+	BinnedPoints out;
+
+	// z band [0, 1] on the wall x = 3.02: rows with |3.02 (23.5 - r) / 50| <= 0.5.
+	const Image wall = wallDepthImage(3.02);
+	size_t rowsIn = 0;
+	for (int r = 0; r < H; r++)
+	{
+		const double z = 0.5 + 3.02 * (23.5 - r) / 50;
+		if (z >= 0 && z <= 1) rowsIn++;
+	}
+	ASSERT_EQ(rowsIn, 16u);	 // r = 16..31
+	ProjectionFilter f;
+	f.z_min = 0.0f;
+	f.z_max = 1.0f;
+	EXPECT_EQ(proj.project(wall.view(), camera(), T, f, grid, out), rowsIn * W);
+	for (float z : out.z)
+	{
+		EXPECT_GE(z, 0.f);
+		EXPECT_LE(z, 1.f);
+	}
+
+	// Left half of the image at 2 m, right half at 4.5 m.
+	Image img;
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++) img.at(r, c) = c < 32 ? 2000 : 4500;
+	ProjectionFilter g;
+	g.max_range = 4.0f;
+	out.clear();
+	EXPECT_EQ(proj.project(img.view(), camera(), T, g, grid, out), size_t(32 * H));
+	for (uint32_t idx : out.cell) EXPECT_EQ(int(idx % 200u), int(std::floor((2.0 + 5) / 0.05)));
+	g.max_range = 5.0f;
+	g.min_range = 3.0f;
+	out.clear();
+	EXPECT_EQ(proj.project(img.view(), camera(), T, g, grid, out), size_t(32 * H));
+	for (uint32_t idx : out.cell) EXPECT_EQ(int(idx % 200u), int(std::floor((4.5 + 5) / 0.05)));
+	g.min_range = 0;
+	out.clear();
+	EXPECT_EQ(proj.project(img.view(), camera(), T, g, grid, out), size_t(W * H));
+}
+
+TEST(DepthProjector, InvalidPixelsAndOutOfGridPointsAreSkipped)
+{
+	const RigidTransform T = pose(Eigen::Matrix3d::Identity(), {0, 0, 0.5});
+	DepthProjector proj;
+	BinnedPoints out;
+	// Checkerboard of zeros: half the pixels.
+	Image img = wallDepthImage(3.02);
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+			if ((r + c) % 2) img.at(r, c) = 0;
+	ElevationGrid grid;
+	EXPECT_EQ(proj.project(img.view(), camera(), T, ProjectionFilter{}, grid, out), size_t(W * H / 2));
+
+	// A grid covering y in [0, 5) only: the columns c <= 31 (y > 0) stay.
+	ElevationGrid half(makeGeometry(-5, 0, 0.05, 200, 100));
+	const Image wall = wallDepthImage(3.02);
+	out.clear();
+	EXPECT_EQ(proj.project(wall.view(), camera(), T, ProjectionFilter{}, half, out), size_t(32 * H));
+	// And one that ends before the wall: nothing.
+	ElevationGrid shortGrid(makeGeometry(-5, -5, 0.05, 150, 200));  // x < 2.5
+	out.clear();
+	EXPECT_EQ(proj.project(wall.view(), camera(), T, ProjectionFilter{}, shortGrid, out), 0u);
+
+	// Row padding (stride > cols) is never read, even if it holds values.
+	Image padded(H, W, W + 5);
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W + 5; c++) padded.at(r, c) = c < W ? 3020 : 1000;
+	out.clear();
+	EXPECT_EQ(proj.project(padded.view(), camera(), T, ProjectionFilter{}, grid, out), size_t(W * H));
+	for (uint32_t idx : out.cell) EXPECT_EQ(int(idx % 200u), 160);
+
+	// project() appends.
+	const size_t before = out.size();
+	proj.project(padded.view(), camera(), T, ProjectionFilter{}, grid, out);
+	EXPECT_EQ(out.size(), 2 * before);
+}
+
+TEST(DepthProjector, RejectsInconsistentInputs)
+{
+	const Image img = wallDepthImage(3.02);
+	const RigidTransform T = pose(Eigen::Matrix3d::Identity(), {0, 0, 0.5});
+	ElevationGrid grid;
+	DepthProjector proj;
+	BinnedPoints out;
+	const ProjectionFilter f;
+
+	// Image size vs intrinsics.
+	PinholeIntrinsics K = camera();
+	K.width = W + 1;
+	EXPECT_THROW(proj.project(img.view(), K, T, f, grid, out), std::invalid_argument);
+	K = camera();
+	K.height = H - 1;
+	EXPECT_THROW(proj.project(img.view(), K, T, f, grid, out), std::invalid_argument);
+	K = camera();
+	K.width = 0;
+	EXPECT_THROW(proj.project(img.view(), K, T, f, grid, out), std::invalid_argument);
+
+	// Focal lengths.
+	for (double bad : {0.0, -50.0, double(NAN), double(INFINITY)})
+	{
+		K = camera();
+		K.fx = bad;
+		EXPECT_THROW(proj.project(img.view(), K, T, f, grid, out), std::invalid_argument) << bad;
+		K = camera();
+		K.fy = bad;
+		EXPECT_THROW(proj.project(img.view(), K, T, f, grid, out), std::invalid_argument) << bad;
+	}
+	K = camera();
+	K.cx = NAN;
+	EXPECT_THROW(proj.project(img.view(), K, T, f, grid, out), std::invalid_argument);
+
+	// rangeUnits.
+	for (float units : {0.0f, -0.001f, float(NAN)})
+		EXPECT_THROW(proj.project(img.view(true, units), camera(), T, f, grid, out), std::invalid_argument)
+			<< units;
+
+	// Non-finite pose.
+	RigidTransform bad = T;
+	bad.t.x() = NAN;
+	EXPECT_THROW(proj.project(img.view(), camera(), bad, f, grid, out), std::invalid_argument);
+	bad = T;
+	bad.R(1, 2) = INFINITY;
+	EXPECT_THROW(proj.project(img.view(), camera(), bad, f, grid, out), std::invalid_argument);
+
+	EXPECT_EQ(out.size(), 0u);	// nothing was binned by the failed calls
+	EXPECT_NO_THROW(proj.project(img.view(), camera(), T, f, grid, out));
+	EXPECT_EQ(out.size(), size_t(W * H));
+}

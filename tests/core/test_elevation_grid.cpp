@@ -1,0 +1,344 @@
+// Ground-aware mapping for MRPT
+// ElevationGrid: geometry, per-cell statistics, 3-sigma filter, IDW.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include "gam/ElevationGrid.h"
+#include "test_helpers.h"
+
+using namespace gam;
+using gamtest::makeGeometry;
+
+TEST(GridGeometry, IndexingAndCentres)
+{
+	const GridGeometry g = makeGeometry(-2.0, 1.0, 0.5, 8, 4);
+	EXPECT_DOUBLE_EQ(g.x_max(), 2.0);
+	EXPECT_DOUBLE_EQ(g.y_max(), 3.0);
+	EXPECT_EQ(g.cellCount(), 32u);
+	EXPECT_EQ(g.ix(-2.0), 0);
+	EXPECT_EQ(g.ix(-1.76), 0);
+	EXPECT_EQ(g.ix(-1.5), 1);
+	EXPECT_EQ(g.ix(1.99), 7);
+	EXPECT_EQ(g.ix(-2.01), -1);	 // floor, not truncation
+	EXPECT_EQ(g.iy(2.3), 2);
+	EXPECT_DOUBLE_EQ(g.cx(0), -1.75);
+	EXPECT_DOUBLE_EQ(g.cy(3), 2.75);
+	EXPECT_EQ(g.index(3, 2), 2u * 8u + 3u);
+	EXPECT_TRUE(g.inside(7, 3));
+	EXPECT_FALSE(g.inside(8, 0));
+	EXPECT_FALSE(g.inside(0, -1));
+}
+
+TEST(GridGeometry, ValidateRejectsBadValues)
+{
+	EXPECT_NO_THROW(GridGeometry{}.validate());
+	EXPECT_THROW(makeGeometry(0, 0, 0.0, 10, 10).validate(), std::invalid_argument);
+	EXPECT_THROW(makeGeometry(0, 0, -0.1, 10, 10).validate(), std::invalid_argument);
+	EXPECT_THROW(makeGeometry(0, 0, NAN, 10, 10).validate(), std::invalid_argument);
+	EXPECT_THROW(makeGeometry(0, 0, 0.1, 0, 10).validate(), std::invalid_argument);
+	EXPECT_THROW(makeGeometry(0, 0, 0.1, 10, -1).validate(), std::invalid_argument);
+	EXPECT_THROW(makeGeometry(0, 0, 0.1, 100000, 100000).validate(), std::invalid_argument);
+	EXPECT_THROW(makeGeometry(NAN, 0, 0.1, 10, 10).validate(), std::invalid_argument);
+	EXPECT_THROW(makeGeometry(0, INFINITY, 0.1, 10, 10).validate(), std::invalid_argument);
+	ElevationGrid grid;
+	EXPECT_THROW(grid.resize(makeGeometry(0, 0, 0.0, 10, 10)), std::invalid_argument);
+}
+
+TEST(ElevationGrid, BinPointInsideAndOutside)
+{
+	ElevationGrid grid(makeGeometry(0, 0, 0.1, 10, 5));
+	BinnedPoints b;
+	EXPECT_TRUE(grid.binPoint(0.25, 0.31, 1.5f, b));
+	ASSERT_EQ(b.size(), 1u);
+	EXPECT_EQ(b.cell[0], 3u * 10u + 2u);
+	EXPECT_FLOAT_EQ(b.z[0], 1.5f);
+	EXPECT_FALSE(grid.binPoint(-0.01, 0.2, 0.f, b));
+	EXPECT_FALSE(grid.binPoint(1.0, 0.2, 0.f, b));
+	EXPECT_FALSE(grid.binPoint(0.5, 0.5, 0.f, b));
+	EXPECT_EQ(b.size(), 1u);
+}
+
+TEST(ElevationGrid, CellStatisticsByHand)
+{
+	ElevationGrid grid(makeGeometry(0, 0, 1.0, 4, 4));
+	BinnedPoints b;
+	for (float z : {0.1f, 0.2f, 0.6f}) grid.binPoint(1.5, 2.5, z, b);
+	grid.binPoint(3.5, 0.5, -1.0f, b);
+	OutlierFilterParams f;	// enabled, but 3 samples < min_count
+	EXPECT_EQ(grid.insert(b, f), 4u);
+	EXPECT_EQ(grid.observedCount(), 2u);
+
+	const ElevationCell& c = grid.cell(1, 2);
+	EXPECT_EQ(c.count, 3u);
+	EXPECT_FLOAT_EQ(c.z_min, 0.1f);
+	EXPECT_FLOAT_EQ(c.z_max, 0.6f);
+	EXPECT_NEAR(c.mean(), 0.3, 1e-6);
+	// (0.01 + 0.04 + 0.36) / 3 - 0.3^2 = 0.0466667
+	EXPECT_NEAR(c.variance(), 0.41 / 3.0 - 0.09, 1e-6);
+	EXPECT_NEAR(c.span(), 0.5, 1e-6);
+	EXPECT_TRUE(std::isnan(c.z_idw));
+
+	const ElevationCell& d = grid.cell(3, 0);
+	EXPECT_EQ(d.count, 1u);
+	EXPECT_FLOAT_EQ(d.mean(), -1.0f);
+	EXPECT_FLOAT_EQ(d.variance(), 0.f);
+	EXPECT_FALSE(grid.cell(0, 0).observed());
+
+	// A second frame merges into the same statistics.
+	b.clear();
+	grid.binPoint(1.2, 2.9, 1.1f, b);
+	grid.insert(b, f);
+	EXPECT_EQ(grid.cell(1, 2).count, 4u);
+	EXPECT_FLOAT_EQ(grid.cell(1, 2).z_max, 1.1f);
+	EXPECT_NEAR(grid.cell(1, 2).mean(), (0.1 + 0.2 + 0.6 + 1.1) / 4.0, 1e-6);
+	EXPECT_EQ(grid.observedCount(), 2u);  // no duplicate in the touched list
+
+	grid.clear();
+	EXPECT_EQ(grid.observedCount(), 0u);
+	EXPECT_EQ(grid.cell(1, 2).count, 0u);
+	EXPECT_FALSE(std::isfinite(grid.cell(1, 2).z_min));
+
+	grid.binPoint(0.5, 0.5, 2.f, b);
+	grid.insert(b, f);
+	grid.recenter(10.0, 20.0);
+	EXPECT_EQ(grid.observedCount(), 0u);
+	EXPECT_EQ(grid.cell(0, 0).count, 0u);
+	EXPECT_DOUBLE_EQ(grid.geometry().x_min, 10.0);
+	EXPECT_DOUBLE_EQ(grid.geometry().y_min, 20.0);
+	EXPECT_EQ(grid.geometry().nx, 4);
+}
+
+namespace
+{
+struct OutlierCase
+{
+	std::vector<float> clean;
+	float outlier = 0.5f;
+};
+OutlierCase makeOutlierCase()
+{
+	std::mt19937 rng(12345);
+	std::normal_distribution<float> N(0.f, 0.01f);
+	OutlierCase oc;
+	for (int i = 0; i < 40; i++) oc.clean.push_back(N(rng));
+	return oc;
+}
+// Bins the 41 samples into cell (2,2) and 10 clean samples into cell (0,0).
+void binOutlierCase(const ElevationGrid& grid, const OutlierCase& oc, BinnedPoints& b)
+{
+	for (float z : oc.clean) grid.binPoint(2.5, 2.5, z, b);
+	grid.binPoint(2.5, 2.5, oc.outlier, b);
+	for (int i = 0; i < 10; i++) grid.binPoint(0.5, 0.5, 1.0f + 0.001f * float(i), b);
+}
+}  // namespace
+
+TEST(ElevationGridFilter, ThreeSigmaRemovesTheOutlier)
+{
+	const OutlierCase oc = makeOutlierCase();
+	// Independent check of the premise: the band mean +- 3 std of the 41
+	// samples excludes +0.5 and keeps every clean sample.
+	double s = 0, s2 = 0;
+	for (float z : oc.clean) s += z, s2 += double(z) * z;
+	s += oc.outlier;
+	s2 += double(oc.outlier) * oc.outlier;
+	const double m = s / 41, sd = std::sqrt(s2 / 41 - m * m);
+	ASSERT_GT(std::abs(oc.outlier - m), 3 * sd);
+	for (float z : oc.clean) ASSERT_LE(std::abs(z - m), 3 * sd);
+
+	ElevationGrid grid(makeGeometry(0, 0, 1.0, 4, 4));
+	BinnedPoints b;
+	binOutlierCase(grid, oc, b);
+	OutlierFilterParams f;	// defaults: enabled, 3 sigma, min_count 4
+	EXPECT_EQ(grid.insert(b, f), 50u);
+
+	const ElevationCell& c = grid.cell(2, 2);
+	EXPECT_EQ(c.count, 40u);
+	EXPECT_FLOAT_EQ(c.z_max, *std::max_element(oc.clean.begin(), oc.clean.end()));
+	EXPECT_FLOAT_EQ(c.z_min, *std::min_element(oc.clean.begin(), oc.clean.end()));
+	double cm = 0;
+	for (float z : oc.clean) cm += z;
+	EXPECT_NEAR(c.mean(), cm / 40, 1e-5);
+	EXPECT_LT(c.z_max, 0.1f);
+	// The clean cell of the same frame is untouched.
+	EXPECT_EQ(grid.cell(0, 0).count, 10u);
+	EXPECT_FLOAT_EQ(grid.cell(0, 0).z_max, 1.009f);
+}
+
+TEST(ElevationGridFilter, SmallCellsKeepEverything)
+{
+	const OutlierCase oc = makeOutlierCase();
+	ElevationGrid grid(makeGeometry(0, 0, 1.0, 4, 4));
+	BinnedPoints b;
+	binOutlierCase(grid, oc, b);
+	OutlierFilterParams f;
+	f.min_count = 42;  // the 41-sample cell is "too small" for the rule
+	EXPECT_EQ(grid.insert(b, f), 51u);
+	EXPECT_EQ(grid.cell(2, 2).count, 41u);
+	EXPECT_FLOAT_EQ(grid.cell(2, 2).z_max, 0.5f);
+
+	// Default min_count = 4: a 3-sample cell with a far sample keeps it.
+	ElevationGrid g2(makeGeometry(0, 0, 1.0, 4, 4));
+	b.clear();
+	for (float z : {0.0f, 0.0f, 5.0f}) g2.binPoint(1.5, 1.5, z, b);
+	EXPECT_EQ(g2.insert(b, OutlierFilterParams{}), 3u);
+	EXPECT_EQ(g2.cell(1, 1).count, 3u);
+	EXPECT_FLOAT_EQ(g2.cell(1, 1).z_max, 5.0f);
+}
+
+TEST(ElevationGridFilter, DisabledKeepsEverything)
+{
+	const OutlierCase oc = makeOutlierCase();
+	ElevationGrid grid(makeGeometry(0, 0, 1.0, 4, 4));
+	BinnedPoints b;
+	binOutlierCase(grid, oc, b);
+	OutlierFilterParams f;
+	f.enabled = false;
+	EXPECT_EQ(grid.insert(b, f), 51u);
+	EXPECT_EQ(grid.cell(2, 2).count, 41u);
+	EXPECT_FLOAT_EQ(grid.cell(2, 2).z_max, 0.5f);
+}
+
+TEST(ElevationGridFilter, FilterIsPerFrame)
+{
+	// The outlier arrives in its own frame: within that frame it is not an
+	// outlier, so it is kept (documented: the rule applies within a frame).
+	const OutlierCase oc = makeOutlierCase();
+	double s = 0, s2 = 0;
+	for (float z : oc.clean) s += z, s2 += double(z) * z;
+	const double m = s / 40, sd = std::sqrt(s2 / 40 - m * m);
+	for (float z : oc.clean) ASSERT_LE(std::abs(z - m), 3 * sd);  // premise
+	ElevationGrid grid(makeGeometry(0, 0, 1.0, 4, 4));
+	BinnedPoints b;
+	for (float z : oc.clean) grid.binPoint(2.5, 2.5, z, b);
+	OutlierFilterParams f;
+	EXPECT_EQ(grid.insert(b, f), 40u);
+	b.clear();
+	grid.binPoint(2.5, 2.5, oc.outlier, b);
+	EXPECT_EQ(grid.insert(b, f), 1u);
+	EXPECT_EQ(grid.cell(2, 2).count, 41u);
+	EXPECT_FLOAT_EQ(grid.cell(2, 2).z_max, 0.5f);
+}
+
+TEST(ElevationGridFilter, TighterSigmasRemoveMore)
+{
+	// Samples {0 x8, 1 x2}: mean 0.2, std 0.4. With 1 sigma (band [-0.2, 0.6])
+	// the two 1's go; with 3 sigma (band [-1.0, 1.4]) nothing goes.
+	ElevationGrid grid(makeGeometry(0, 0, 1.0, 2, 2));
+	BinnedPoints b;
+	for (int i = 0; i < 8; i++) grid.binPoint(0.5, 0.5, 0.f, b);
+	for (int i = 0; i < 2; i++) grid.binPoint(0.5, 0.5, 1.f, b);
+	OutlierFilterParams f;
+	f.sigmas = 1.0f;
+	EXPECT_EQ(grid.insert(b, f), 8u);
+	EXPECT_EQ(grid.cell(0, 0).count, 8u);
+	EXPECT_FLOAT_EQ(grid.cell(0, 0).z_max, 0.f);
+
+	ElevationGrid g3(makeGeometry(0, 0, 1.0, 2, 2));
+	EXPECT_EQ(g3.insert(b, OutlierFilterParams{}), 10u);
+	EXPECT_EQ(g3.cell(0, 0).count, 10u);
+}
+
+namespace
+{
+// 10x10 cells of 1 m; observed: (4,5) z=1, (6,5) z=2, (6,6) z=3.
+ElevationGrid makeIdwGrid()
+{
+	ElevationGrid grid(makeGeometry(0, 0, 1.0, 10, 10));
+	gamtest::insertPoints(grid, {{4.5, 5.5, 1.0}, {6.5, 5.5, 2.0}, {6.5, 6.5, 3.0}});
+	return grid;
+}
+}  // namespace
+
+TEST(ElevationGridIdw, HandComputedWeightedAverages)
+{
+	ElevationGrid grid = makeIdwGrid();
+	IdwParams p;
+	p.radius_cells = 1;
+	p.power = 2;
+	p.min_neighbours = 3;
+	// Only (5,5) and (5,6) see all three observed cells in their 3x3 window.
+	EXPECT_EQ(grid.interpolateIdw(p), 2u);
+	// (5,5): (4,5) d=1 w=1, (6,5) d=1 w=1, (6,6) d=sqrt2 w=1/2
+	EXPECT_NEAR(grid.cell(5, 5).z_idw, (1 * 1.0 + 1 * 2.0 + 0.5 * 3.0) / 2.5, 1e-5);  // 1.8
+	// (5,6): (4,5) w=1/2, (6,5) w=1/2, (6,6) w=1
+	EXPECT_NEAR(grid.cell(5, 6).z_idw, (0.5 * 1.0 + 0.5 * 2.0 + 1 * 3.0) / 2.0, 1e-5);	// 2.25
+	// min_neighbours respected: (7,6) and (5,4) see only two observed cells.
+	EXPECT_TRUE(std::isnan(grid.cell(7, 6).z_idw));
+	EXPECT_TRUE(std::isnan(grid.cell(5, 4).z_idw));
+	EXPECT_TRUE(std::isnan(grid.cell(0, 0).z_idw));
+
+	// Estimates are never observations.
+	EXPECT_EQ(grid.cell(5, 5).count, 0u);
+	EXPECT_FALSE(grid.cell(5, 5).observed());
+	EXPECT_EQ(grid.observedCount(), 3u);
+	EXPECT_NEAR(grid.surfaceHeight(5, 5), 1.8, 1e-5);
+	EXPECT_TRUE(std::isnan(grid.surfaceHeight(0, 0)));
+
+	// Observed cells are never overwritten.
+	EXPECT_TRUE(std::isnan(grid.cell(4, 5).z_idw));
+	EXPECT_EQ(grid.cell(4, 5).count, 1u);
+	EXPECT_FLOAT_EQ(grid.surfaceHeight(4, 5), 1.0f);
+	EXPECT_FLOAT_EQ(grid.surfaceHeight(6, 6), 3.0f);
+}
+
+TEST(ElevationGridIdw, FewerNeighboursAndOtherPower)
+{
+	ElevationGrid grid = makeIdwGrid();
+	IdwParams p;
+	p.radius_cells = 1;
+	p.min_neighbours = 2;
+	grid.interpolateIdw(p);
+	// (7,6): (6,5) d=sqrt2 w=1/2 z=2, (6,6) d=1 w=1 z=3
+	EXPECT_NEAR(grid.cell(7, 6).z_idw, (0.5 * 2.0 + 3.0) / 1.5, 1e-5);
+	// (5,4): (4,5), (6,5) both at sqrt2 -> plain mean
+	EXPECT_NEAR(grid.cell(5, 4).z_idw, 1.5, 1e-5);
+
+	p.power = 1;
+	p.min_neighbours = 3;
+	EXPECT_EQ(grid.interpolateIdw(p), 2u);
+	const double w = 1.0 / std::sqrt(2.0);
+	EXPECT_NEAR(grid.cell(5, 5).z_idw, (1.0 + 2.0 + w * 3.0) / (2.0 + w), 1e-5);
+	// The previous run's estimates are forgotten.
+	EXPECT_TRUE(std::isnan(grid.cell(7, 6).z_idw));
+	EXPECT_TRUE(std::isnan(grid.cell(5, 4).z_idw));
+
+	// radius 0 disables it and forgets everything.
+	p.radius_cells = 0;
+	EXPECT_EQ(grid.interpolateIdw(p), 0u);
+	EXPECT_TRUE(std::isnan(grid.cell(5, 5).z_idw));
+}
+
+TEST(ElevationGridIdw, LargerRadiusAndObservationReplacesEstimate)
+{
+	ElevationGrid grid = makeIdwGrid();
+	IdwParams p;
+	p.radius_cells = 2;
+	p.min_neighbours = 3;
+	grid.interpolateIdw(p);
+	// (4,7): (4,5) d=2 w=1/4 z=1; (6,5) d=sqrt8 w=1/8 z=2; (6,6) d=sqrt5 w=1/5 z=3
+	EXPECT_NEAR(
+		grid.cell(4, 7).z_idw, (0.25 * 1 + 0.125 * 2 + 0.2 * 3) / (0.25 + 0.125 + 0.2), 1e-5);
+	// (8,8): only (6,6) (d=sqrt8) within 2 cells
+	EXPECT_TRUE(std::isnan(grid.cell(8, 8).z_idw));
+	// (3,4) is within reach of (4,5) d=sqrt2 and (6,5)? dx=3 > 2: no. -> NaN
+	EXPECT_TRUE(std::isnan(grid.cell(3, 4).z_idw));
+
+	// A real observation in an interpolated cell replaces the estimate.
+	gamtest::insertPoints(grid, {{4.5, 7.5, 7.0}});
+	EXPECT_EQ(grid.cell(4, 7).count, 1u);
+	EXPECT_TRUE(std::isnan(grid.cell(4, 7).z_idw));
+	EXPECT_FLOAT_EQ(grid.surfaceHeight(4, 7), 7.0f);
+	EXPECT_EQ(grid.observedCount(), 4u);
+
+	// clear() also removes the estimates.
+	grid.clear();
+	for (const ElevationCell& c : grid.cells())
+	{
+		EXPECT_EQ(c.count, 0u);
+		EXPECT_TRUE(std::isnan(c.z_idw));
+	}
+}

@@ -1,0 +1,89 @@
+// Ground-aware mapping for MRPT
+// Small helpers shared by the ground_core unit tests (synthetic scenes).
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include "gam/ElevationGrid.h"
+
+namespace gamtest
+{
+inline constexpr double kPi = 3.14159265358979323846;
+inline double deg2rad(double d) { return d * kPi / 180.0; }
+inline double rad2deg(double r) { return r * 180.0 / kPi; }
+
+inline gam::GridGeometry makeGeometry(double x_min, double y_min, double res, int nx, int ny)
+{
+	gam::GridGeometry g;
+	g.x_min = x_min;
+	g.y_min = y_min;
+	g.resolution = res;
+	g.nx = nx;
+	g.ny = ny;
+	return g;
+}
+
+/** Inserts the points (x, y, z) into the grid, one frame, no outlier filter. */
+inline void insertPoints(gam::ElevationGrid& grid, const std::vector<std::array<double, 3>>& pts)
+{
+	gam::BinnedPoints b;
+	for (const auto& p : pts) grid.binPoint(p[0], p[1], float(p[2]), b);
+	gam::OutlierFilterParams f;
+	f.enabled = false;
+	grid.insert(b, f);
+}
+
+/** Samples every cell whose centre lies in [x0, x1) x [y0, y1) with `n`
+ * points spread over the cell (a regular sub-grid), heights z(x, y) plus
+ * N(0, noise) noise. Returns the binned points (not inserted). */
+inline void sampleSurface(
+	const gam::ElevationGrid& grid, double x0, double x1, double y0, double y1,
+	const std::function<double(double, double)>& z, int nPerAxis, double noise, std::mt19937& rng,
+	gam::BinnedPoints& out)
+{
+	const gam::GridGeometry& g = grid.geometry();
+	std::normal_distribution<double> N(0.0, noise > 0 ? noise : 1.0);
+	for (int cy = 0; cy < g.ny; cy++)
+		for (int cx = 0; cx < g.nx; cx++)
+		{
+			const double xc = g.cx(cx), yc = g.cy(cy);
+			if (xc < x0 || xc >= x1 || yc < y0 || yc >= y1) continue;
+			for (int j = 0; j < nPerAxis; j++)
+				for (int i = 0; i < nPerAxis; i++)
+				{
+					const double x = g.x_min + (cx + (i + 0.5) / nPerAxis) * g.resolution;
+					const double y = g.y_min + (cy + (j + 0.5) / nPerAxis) * g.resolution;
+					const double zz = z(x, y) + (noise > 0 ? N(rng) : 0.0);
+					grid.binPoint(x, y, float(zz), out);
+				}
+		}
+}
+
+/** Samples vertical columns (walls, box sides): every cell centre in the
+ * rectangle gets points at heights z0, z0+dz, ..., z1. */
+inline void sampleColumns(
+	const gam::ElevationGrid& grid, double x0, double x1, double y0, double y1, double z0,
+	double z1, double dz, gam::BinnedPoints& out)
+{
+	const gam::GridGeometry& g = grid.geometry();
+	for (int cy = 0; cy < g.ny; cy++)
+		for (int cx = 0; cx < g.nx; cx++)
+		{
+			const double xc = g.cx(cx), yc = g.cy(cy);
+			if (xc < x0 || xc >= x1 || yc < y0 || yc >= y1) continue;
+			for (double zz = z0; zz <= z1 + 1e-9; zz += dz) grid.binPoint(xc, yc, float(zz), out);
+		}
+}
+
+inline void insertAll(gam::ElevationGrid& grid, const gam::BinnedPoints& b)
+{
+	gam::OutlierFilterParams f;
+	f.enabled = false;
+	grid.insert(b, f);
+}
+
+}  // namespace gamtest
