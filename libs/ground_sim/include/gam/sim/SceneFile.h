@@ -1,0 +1,78 @@
+// Ground-aware mapping for MRPT -- scene simulator: the scene text format.
+//
+// One statement per line; '#' starts a comment; blank lines are ignored.
+// A statement is a keyword followed by key=value arguments (no spaces inside
+// a value; lists are comma separated). Lengths in metres, ALL ANGLES IN
+// DEGREES. World frame: +X forward, +Y left, +Z up, floor at z = 0.
+// Every object needs a unique integer id >= 1; name= and category= (negative,
+// small, overhang, large, ramp) are optional on every object.
+//
+//   floor present=1                      # present=0: no floor at all
+//   kinect pose=x,y,z,yaw,pitch,roll     # on the robot; pitch>0 looks down
+//          [noise_scale=1] [min_range=0.5] [max_range=4.5] [spike_prob=1e-4]
+//          [flying_prob=0.5] [grazing_start=70] [grazing_end=85]
+//   leddar pose=x,y,z,yaw,pitch,roll [enabled=1] [sigma=0.025] [max_range=50] [vfov=3]
+//   hole id= shape=rect x= y= sx= sy= [yaw=0] depth=0.06|inf     # centre, sizes
+//   hole id= shape=circle x= y= r= depth=
+//   box id= x= y= [z=0] sx= sy= sz= [yaw=0] [pitch=0] [roll=0]  # x,y: footprint centre, z: bottom
+//   wall id= x0= y0= x1= y1= [thickness=0.10] [height=2.5]
+//   stairs_down id= x= y= yaw= width= steps= rise= run= [landing=1.0]
+//        # (x,y): centre of the top edge; descends along yaw; pit length
+//        # steps*run + landing, depth steps*rise (its bottom is the lower floor)
+//   stairs_up id= x= y= yaw= width= steps= rise= run= [top=1.0]
+//        # first riser at (x,y), climbing along yaw, then a top landing
+//   ramp id= x= y= yaw= length= width= angle= [sides=solid|open] [thickness=0.03]
+//        [plateau=0] [back=0]
+//        # rises along yaw from (x,y) (centre of the low edge); solid = wedge
+//        # with side walls, open = tilted plate; plateau = flat top length;
+//        # back=1 adds the symmetric way down
+//   table id= x= y= [yaw=0] sx= sy= [height=0.75] [top=0.04] [leg=0.05]
+//   shelf id= x= y= [yaw=0] sx= sy= sz= [boards=4] [board=0.02] [side=0.02] [bottom=0.10]
+//        # two side panels + `boards` boards from `bottom` up to sz
+//   path waypoints=x,y,yaw;x,y,yaw;... [spacing=0.10] [turn_spacing=5] [frames=0] [rate=10]
+//        # one waypoint: `frames` frames taken there (default 1)
+//   odometry_noise [xy=0] [yaw=0] [turn=0]
+//        # per increment: sigma_xy = xy*dist, sigma_yaw = yaw(deg/m)*dist + turn*|dyaw|
+//   grid resolution=0.05 min_x= max_x= min_y= max_y= [robot_height=1.9]
+//        [obstacle_min=0.02] [drop_min=0.02] [small_max=0.20] [overhang_clearance=0.10]
+//        [max_slope=10] [subsamples=3]
+//
+// Errors throw SceneError with "file:line: message".
+#pragma once
+
+#include <istream>
+#include <stdexcept>
+#include <string>
+
+#include "gam/sim/GroundTruth.h"
+#include "gam/sim/Path.h"
+#include "gam/sim/Scene.h"
+#include "gam/sim/Sensors.h"
+
+namespace gam::sim
+{
+class SceneError : public std::runtime_error
+{
+   public:
+	using std::runtime_error::runtime_error;
+};
+
+struct SceneFile
+{
+	Scene scene;
+	KinectParams kinect;
+	Pose3 kinect_pose = Pose3::fromXYZYPR(0.10, 0, 1.0, 0, 25 * M_PI / 180, 0);
+	LeddarParams leddar;
+	Pose3 leddar_pose = Pose3::fromXYZYPR(0.20, 0, 0.30, 0, 0, 0);
+	bool leddar_enabled = true;
+	PathSpec path;
+	OdometryNoise odometry_noise;
+	GridSpec grid;
+	bool has_grid = false;
+};
+
+/** Parses a scene; `filename` is used in the error messages only. */
+SceneFile parseScene(std::istream& in, const std::string& filename);
+SceneFile parseSceneFile(const std::string& path);
+
+}  // namespace gam::sim
