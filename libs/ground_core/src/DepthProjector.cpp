@@ -18,6 +18,9 @@ void PinholeIntrinsics::validate() const
 			", fy=" + std::to_string(fy) + ")");
 	if (!std::isfinite(cx) || !std::isfinite(cy))
 		throw std::invalid_argument("camera principal point must be finite");
+	if (!std::isfinite(k1) || !std::isfinite(k2) || !std::isfinite(k3) || !std::isfinite(p1) ||
+		!std::isfinite(p2))
+		throw std::invalid_argument("camera distortion coefficients must be finite");
 }
 
 void DepthProjector::updateLut(const PinholeIntrinsics& K)
@@ -30,8 +33,25 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 		for (int c = 0; c < K.width; c++)
 		{
 			// MRPT's convention (CObservation3DRangeScan::unprojectInto):
-			// x = D, y = (cx - c) * D / fx, z = (cy - r) * D / fy.
-			const float ky = float((K.cx - c) / K.fx), kz = float((K.cy - r) / K.fy);
+			// x = D, y = (cx - c) * D / fx, z = (cy - r) * D / fy, with (c, r)
+			// first undistorted. Normalized image coordinates (right, down):
+			const double xd = (c - K.cx) / K.fx, yd = (r - K.cy) / K.fy;
+			double xu = xd, yu = yd;
+			if (K.k1 != 0 || K.k2 != 0 || K.k3 != 0 || K.p1 != 0 || K.p2 != 0)
+			{
+				// Invert the distortion by fixed-point iteration (converges in a
+				// few steps for the mild distortion of depth cameras).
+				for (int it = 0; it < 20; it++)
+				{
+					const double r2 = xu * xu + yu * yu;
+					const double radial = 1 + r2 * (K.k1 + r2 * (K.k2 + r2 * K.k3));
+					const double dx = 2 * K.p1 * xu * yu + K.p2 * (r2 + 2 * xu * xu);
+					const double dy = K.p1 * (r2 + 2 * yu * yu) + 2 * K.p2 * xu * yu;
+					xu = (xd - dx) / radial;
+					yu = (yd - dy) / radial;
+				}
+			}
+			const float ky = float(-xu), kz = float(-yu);
 			const size_t i = size_t(r) * size_t(K.width) + size_t(c);
 			m_lut[i] = {ky, kz};
 			m_lutNorm[i] = std::sqrt(1.0f + ky * ky + kz * kz);

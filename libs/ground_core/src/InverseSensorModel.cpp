@@ -212,7 +212,9 @@ void InverseSensorModel::compute(
 		const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
 		const Plane& pl = choosePlane(det, c, x, y, block);
 		const double hs = pl.signedDistance(sensor.x(), sensor.y(), sensor.z());
-		const double dp = pl.signedDistance(x, y, c.z_max);
+		// The deepest sample's ray crossed the ground nearest to the robot:
+		// it bounds the part of the hole that no floor stopped.
+		const double dp = pl.signedDistance(x, y, c.z_min);
 		if (!(hs > 0) || !(dp < 0)) continue;
 		const double t = hs / (hs - dp);  // ray parameter at the crossing
 		const double ex = sensor.x() + t * (x - sensor.x()), ey = sensor.y() + t * (y - sensor.y());

@@ -193,7 +193,10 @@ gam::ProjectionFilter CGroundAwareOccupancyGrid::TGroundAwareOptions::projection
 	f.min_range = min_range;
 	f.max_range = max_range;
 	f.z_min = float(robotZ + z_min);
-	f.z_max = float(robotZ + z_max);
+	// Points above the robot can never block it; dropping them here keeps a
+	// beam or a door frame from merging with the floor below it into one tall
+	// 2.5D column (a cell keeps only z-min and z-max).
+	f.z_max = float(robotZ + std::min<double>(z_max, robot_height));
 	f.decimation = decimation;
 	return f;
 }

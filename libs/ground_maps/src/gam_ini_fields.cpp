@@ -46,7 +46,7 @@ std::string trim(std::string s)
 
 void load(const Fields& fields, const mrpt::config::CConfigFileBase& src, const std::string& section)
 {
-	const std::string ctx = "[" + section + "]";
+	const std::string ctx = "in section '" + section + "':";
 	for (const Field& fl : fields)
 	{
 		if (!src.keyExists(section, fl.key)) continue;

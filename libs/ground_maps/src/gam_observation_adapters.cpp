@@ -25,6 +25,12 @@ PinholeIntrinsics intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& o)
 	K.fy = o.cameraParams.fy();
 	K.cx = o.cameraParams.cx();
 	K.cy = o.cameraParams.cy();
+	// TCamera::dist = [k1 k2 p1 p2 k3 ...] (plumb_bob)
+	K.k1 = o.cameraParams.k1();
+	K.k2 = o.cameraParams.k2();
+	K.p1 = o.cameraParams.p1();
+	K.p2 = o.cameraParams.p2();
+	K.k3 = o.cameraParams.k3();
 	return K;
 }
 

@@ -17,10 +17,14 @@ struct PinholeIntrinsics
 {
 	int width = 0, height = 0;
 	double fx = 0, fy = 0, cx = 0, cy = 0;
+	/** Lens distortion, plumb-bob / Brown-Conrady (as MRPT's TCamera::dist):
+	 * radial k1, k2, k3 and tangential p1, p2. Pixels are undistorted when the
+	 * ray table is built, so it costs nothing per frame. */
+	double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
 	bool operator==(const PinholeIntrinsics& o) const
 	{
 		return width == o.width && height == o.height && fx == o.fx && fy == o.fy && cx == o.cx &&
-			   cy == o.cy;
+			   cy == o.cy && k1 == o.k1 && k2 == o.k2 && p1 == o.p1 && p2 == o.p2 && k3 == o.k3;
 	}
 	/** Throws std::invalid_argument naming the bad value. */
 	void validate() const;

@@ -1,0 +1,201 @@
+// CGroundAwareOccupancyGrid on exact synthetic depth frames of known scenes.
+#include <gtest/gtest.h>
+#include <mrpt/maps/CGroundAwareOccupancyGrid.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+
+#include "synthetic_scene.h"
+
+using namespace mrpt::maps;
+using mrpt::DEG2RAD;
+using mrpt::poses::CPose3D;
+using testscene::Box;
+
+namespace
+{
+// A walker's Kinect: 1 m up, pitched 25 deg down.
+const CPose3D kKinect(0, 0, 1.0, 0, DEG2RAD(25.0), 0);
+
+// Floor with a 0.4 x 0.6 m hole (0.5 m deep) at x 2.0-2.4, a 10 cm box.
+std::vector<Box> holeAndBoxScene()
+{
+	auto s = testscene::floorWithHole(-1, 6, -3, 3, 2.0, 2.4, -0.3, 0.3, 0.5);
+	s.push_back({1.5, 0.6, 0.0, 1.7, 0.8, 0.10});
+	return s;
+}
+
+double pOcc(const COccupancyGridMap2D& g, double x, double y) { return 1.0 - g.getPos(float(x), float(y)); }
+}  // namespace
+
+TEST(GroundAwareGrid, FloorFreeBoxAndHoleOccupied)
+{
+	CGroundAwareOccupancyGrid g;
+	g.insertObservation(*testscene::renderDepth(holeAndBoxScene(), kKinect));
+	const auto& d = g.lastFrame();
+	ASSERT_TRUE(d.detection.ok()) << d.detection.describe();
+	EXPECT_NEAR(d.detection.plane().tiltAngle(), 0.0, DEG2RAD(0.5));
+	EXPECT_NEAR(d.detection.plane().heightAt(1, 0), 0.0, 0.01);
+	EXPECT_GT(d.ism.drop, 0u);
+	EXPECT_GT(d.ism.drop_ray_cells, 0u);
+
+	EXPECT_LT(pOcc(g, 1.0, -0.5), 0.3) << "floor";
+	EXPECT_LT(pOcc(g, 2.8, 0.0), 0.3) << "floor beyond the hole";
+	EXPECT_GT(pOcc(g, 1.6, 0.7), 0.7) << "box";
+	EXPECT_GT(pOcc(g, 2.2, 0.0), 0.7) << "hole centre";
+	EXPECT_GT(pOcc(g, 2.05, 0.0), 0.7) << "hole near edge (only drop rays see it)";
+	// Outside the field of view: unknown.
+	EXPECT_NEAR(pOcc(g, -0.5, 0.0), 0.5, 1e-3);
+}
+
+TEST(GroundAwareGrid, HeightBandBaselineMissesTheSameHoleAndBox)
+{
+	// What pointcloud_to_laserscan (z 0.2-1.5 m) + a grid gives on the same frame.
+	auto obs = testscene::renderDepth(holeAndBoxScene(), kKinect);
+	mrpt::obs::T3DPointsTo2DScanParams sp;
+	sp.use_origin_sensor_pose = true;
+	sp.z_min = 0.2;
+	sp.z_max = 1.5;
+	mrpt::obs::CObservation2DRangeScan scan;
+	obs->convertTo2DScan(scan, sp);
+	COccupancyGridMap2D band(-10, 10, -10, 10, 0.05);
+	band.insertionOptions.considerInvalidRangesAsFreeSpace = false;
+	band.insertObservation(scan);
+	EXPECT_LE(pOcc(band, 1.6, 0.7), 0.5);
+	EXPECT_LE(pOcc(band, 2.2, 0.0), 0.5);
+}
+
+TEST(GroundAwareGrid, RampStaysFreeWithLocalPlanesOnly)
+{
+	// Floor, then a 2 m wide 6 deg ramp from x=2.5 to x=4 (1 cm steps every
+	// 9.5 cm), then a landing.
+	std::vector<Box> s = {{-1, -3, -0.1, 2.5, 3, 0.0}, {2.5, -3, -0.1, 6, -1, 0.0}, {2.5, 1, -0.1, 6, 3, 0.0}};
+	const double slope = std::tan(DEG2RAD(6.0));
+	for (double x = 2.5; x < 4.0 - 1e-9; x += 0.01 / slope)
+		s.push_back({x, -1.0, -0.1, x + 0.01 / slope, 1.0, (x - 2.5) * slope + 0.01});
+	s.push_back({4.0, -1.0, -0.1, 6.0, 1.0, 1.5 * slope});
+
+	CGroundAwareOccupancyGrid local, global;
+	global.groundOptions.local_planes = false;
+	auto obs = testscene::renderDepth(s, kKinect);
+	local.insertObservation(*obs);
+	global.insertObservation(*obs);
+	ASSERT_TRUE(local.lastFrame().detection.ok());
+	EXPECT_NEAR(local.lastFrame().detection.plane().heightAt(1.5, 0), 0.0, 0.01) << "the floor is the main plane";
+	EXPECT_GE(local.lastFrame().detection.planes.size(), 2u) << local.lastFrame().detection.describe();
+	int freeLocal = 0, occGlobal = 0, n = 0;
+	for (double x = 3.2; x <= 3.9; x += 0.1)
+		for (double y = -0.4; y <= 0.4; y += 0.1)
+		{
+			n++;
+			freeLocal += pOcc(local, x, y) < 0.4;
+			occGlobal += pOcc(global, x, y) > 0.6;
+		}
+	EXPECT_GE(freeLocal, n * 8 / 10) << "ramp cells free with local planes";
+	EXPECT_GE(occGlobal, n * 8 / 10) << "one global plane turns the ramp into an obstacle";
+}
+
+TEST(GroundAwareGrid, OverheadBeamDoesNotBlockButATableDoes)
+{
+	// A camera 0.9 m up sees a beam at 1.1-1.2 m (above robot_height = 1.0)
+	// and a table top at 0.7 m (below it), both from x = 2.5.
+	std::vector<Box> s = {{-1, -3, -0.1, 8, 3, 0.0},
+						  {2.5, -1.5, 1.1, 3.5, -0.5, 1.2},	 // beam
+						  {2.5, 0.5, 0.68, 3.5, 1.5, 0.72}};	 // table top
+	CGroundAwareOccupancyGrid g;
+	g.groundOptions.robot_height = 1.0;
+	g.insertObservation(*testscene::renderDepth(s, CPose3D(0, 0, 0.9, 0, DEG2RAD(15.0), 0), {}, 512, 424));
+	ASSERT_TRUE(g.lastFrame().detection.ok());
+	int beamFree = 0, tableOcc = 0, n = 0;
+	for (double x = 2.525; x < 2.9; x += 0.05)
+		for (double y = -1.3; y <= -0.7; y += 0.1)
+		{
+			n++;
+			beamFree += pOcc(g, x, y) < 0.4;
+			tableOcc += pOcc(g, x, -y) > 0.6;
+		}
+	EXPECT_GE(beamFree, n * 9 / 10) << "floor under the beam";
+	EXPECT_GE(tableOcc, n / 10) << "the table top";
+	EXPECT_GT(pOcc(g, 2.525, 1.0), 0.7) << "the table's front edge";
+}
+
+TEST(GroundAwareGrid, NoFloorInViewChangesNothing)
+{
+	// Camera looking up at a wall 1.5 m away: no floor, so no plane.
+	std::vector<Box> s = {{1.5, -3, 0.5, 1.7, 3, 3.0}, {1.0, -0.5, 1.2, 1.5, 0.5, 1.25}};
+	CGroundAwareOccupancyGrid g;
+	const auto before = g.getRawMap();
+	EXPECT_TRUE(g.insertObservation(*testscene::renderDepth(s, CPose3D(0, 0, 1.5, 0, DEG2RAD(-20.0), 0))));
+	EXPECT_FALSE(g.lastFrame().detection.ok());
+	EXPECT_TRUE(g.lastFrameIsm().evidenceCells().empty());
+	EXPECT_EQ(g.getRawMap(), before) << "a frame without ground must not invent obstacles";
+}
+
+TEST(GroundAwareGrid, TiltedRolledMountAndRobotPose)
+{
+	// Sensor rolled 8 deg and pitched 30 deg; robot at (1, 2) facing +y.
+	const CPose3D robot(1.0, 2.0, 0, DEG2RAD(90.0), 0, 0);
+	const CPose3D mount(0.1, 0.05, 1.1, DEG2RAD(3.0), DEG2RAD(30.0), DEG2RAD(8.0));
+	// In the world: a box 1.5 m in front of the robot (world y = 3.5).
+	std::vector<Box> s = {{-3, -2, -0.1, 5, 8, 0.0}, {0.9, 3.4, 0.0, 1.1, 3.6, 0.08}};
+	CGroundAwareOccupancyGrid g;
+	g.insertObservation(*testscene::renderDepth(s, mount, robot), robot);
+	ASSERT_TRUE(g.lastFrame().detection.ok()) << g.lastFrame().detection.describe();
+	EXPECT_NEAR(g.lastFrame().detection.plane().tiltAngle(), 0.0, DEG2RAD(0.5));
+	EXPECT_GT(pOcc(g, 1.0, 3.5), 0.7) << "box at its world position";
+	EXPECT_LT(pOcc(g, 1.0, 4.5), 0.3) << "floor behind it";
+	EXPECT_LT(pOcc(g, 0.5, 3.0), 0.3) << "floor beside it";
+}
+
+TEST(GroundAwareGrid, EvidenceAccumulatesOverFrames)
+{
+	CGroundAwareOccupancyGrid g;
+	auto obs = testscene::renderDepth(holeAndBoxScene(), kKinect);
+	g.insertObservation(*obs);
+	const double p1 = pOcc(g, 1.6, 0.7), f1 = pOcc(g, 1.0, -0.5);
+	g.insertObservation(*obs);
+	EXPECT_GT(pOcc(g, 1.6, 0.7), p1);
+	EXPECT_LT(pOcc(g, 1.0, -0.5), f1);
+}
+
+TEST(GroundAwareGrid, LeddarScanFusesThroughTheBeamModel)
+{
+	// 16 segments over 45 deg, a wall 3 m ahead.
+	mrpt::obs::CObservation2DRangeScan s;
+	s.aperture = float(DEG2RAD(45.0));
+	s.rightToLeft = true;
+	s.maxRange = 50;
+	s.sensorPose = CPose3D(0.2, 0, 0.3, 0, 0, 0);
+	s.resizeScan(16);
+	for (size_t i = 0; i < 16; i++)
+	{
+		const double a = -s.aperture / 2 + (i + 0.5) * s.aperture / 16;
+		s.setScanRange(i, float(2.8 / std::cos(a)));  // wall at x = 3.0 in the robot frame
+		s.setScanRangeValidity(i, true);
+	}
+	CGroundAwareOccupancyGrid g;
+	ASSERT_TRUE(g.insertObservation(s));
+	EXPECT_GT(pOcc(g, 3.0, 0.0), 0.6);
+	EXPECT_GT(pOcc(g, 3.0, 0.9), 0.6) << "edge segment covered (upsampled beams)";
+	EXPECT_LT(pOcc(g, 1.5, 0.0), 0.4);
+}
+
+TEST(GroundAwareGrid, MalformedObservationsThrowClearErrors)
+{
+	auto obs = testscene::renderDepth(holeAndBoxScene(), kKinect);
+	CGroundAwareOccupancyGrid g;
+	auto bad = *obs;
+	bad.cameraParams.ncols = 100;  // image is 256 wide
+	EXPECT_THROW(g.insertObservation(bad), std::invalid_argument);
+	bad = *obs;
+	bad.rangeUnits = 0;
+	EXPECT_THROW(g.insertObservation(bad), std::invalid_argument);
+	bad = *obs;
+	bad.cameraParams.setIntrinsicParamsFromValues(0, 0, 10, 10);
+	EXPECT_THROW(g.insertObservation(bad), std::invalid_argument);
+	// All-zero range image: nothing seen, nothing changed.
+	bad = *obs;
+	bad.rangeImage.fill(0);
+	const auto before = g.getRawMap();
+	EXPECT_NO_THROW(g.insertObservation(bad));
+	EXPECT_EQ(g.getRawMap(), before);
+}

@@ -1,0 +1,178 @@
+// Plugin registration, CMultiMetricMap .ini construction and option checks.
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/maps/CElevation25DMap.h>
+#include <mrpt/maps/CGroundAwareOccupancyGrid.h>
+#include <mrpt/maps/CMultiMetricMap.h>
+#include <mrpt/maps/registerGroundAwareMaps.h>
+#include <mrpt/rtti/CObject.h>
+
+using namespace mrpt::maps;
+
+namespace
+{
+TSetOfMetricMapInitializers initsFrom(const std::string& ini, const std::string& section = "map")
+{
+	mrpt::config::CConfigFileMemory cfg(ini);
+	TSetOfMetricMapInitializers inits;
+	inits.loadFromConfigFile(cfg, section);
+	return inits;
+}
+}  // namespace
+
+TEST(Registration, ClassesKnownToMrptRtti)
+{
+	registerGroundAwareMaps();
+	EXPECT_NE(mrpt::rtti::findRegisteredClass("mrpt::maps::CElevation25DMap"), nullptr);
+	EXPECT_NE(mrpt::rtti::findRegisteredClass("mrpt::maps::CGroundAwareOccupancyGrid"), nullptr);
+	for (const char* name : {"CElevation25DMap", "elevation25DMap", "CGroundAwareOccupancyGrid", "groundAwareGrid",
+							 "mrpt::maps::CGroundAwareOccupancyGrid"})
+	{
+		std::unique_ptr<TMetricMapInitializer> def(TMetricMapInitializer::factory(name));
+		EXPECT_TRUE(def) << name;
+	}
+}
+
+TEST(IniConstruction, BothMapsFromStandardSections)
+{
+	const auto inits = initsFrom(R"(
+[map]
+groundAwareGrid_count=1
+CElevation25DMap_count=1
+occupancyGrid_count=1
+[map_groundAwareGrid_00_creationOpts]
+min_x=-4
+max_x=6
+min_y=-3
+max_y=3
+resolution=0.1
+[map_groundAwareGrid_00_groundOpts]
+K=300
+N_th=0.15
+d_pth=0.04
+local_planes=false
+[map_CElevation25DMap_00_creationOpts]
+resolution=0.02
+min_x=-1
+max_x=1
+min_y=-1
+max_y=1
+[map_CElevation25DMap_00_insertOpts]
+idw_radius=2
+outlier_filter=false
+)");
+	CMultiMetricMap mm(inits);
+	ASSERT_EQ(mm.maps.size(), 3u);
+	auto ga = mm.mapByClass<CGroundAwareOccupancyGrid>();
+	auto el = mm.mapByClass<CElevation25DMap>();
+	ASSERT_TRUE(ga);
+	ASSERT_TRUE(el);
+	EXPECT_NEAR(ga->getResolution(), 0.1, 1e-6);
+	EXPECT_NEAR(ga->getXMin(), -4, 1e-4);
+	EXPECT_NEAR(ga->getXMax(), 6, 1e-4);
+	EXPECT_EQ(ga->groundOptions.K, 300);
+	EXPECT_DOUBLE_EQ(ga->groundOptions.N_th, 0.15);
+	EXPECT_DOUBLE_EQ(ga->groundOptions.d_pth, 0.04);
+	EXPECT_FALSE(ga->groundOptions.local_planes);
+	EXPECT_EQ(ga->groundOptions.s_x, 3);  // untouched keys keep Table I defaults
+	EXPECT_EQ(el->grid().geometry().nx, 100);
+	EXPECT_DOUBLE_EQ(el->grid().geometry().resolution, 0.02);
+	EXPECT_EQ(el->insertionOptions.idw_radius, 2);
+	EXPECT_FALSE(el->insertionOptions.outlier_filter);
+	// The derived grid is also found as a COccupancyGridMap2D (MRPT tools rely on it).
+	EXPECT_EQ(mm.countMapsByClass<COccupancyGridMap2D>(), 2u);
+}
+
+TEST(IniConstruction, DefaultsAreThePaperTableI)
+{
+	CGroundAwareOccupancyGrid g;
+	const auto& o = g.groundOptions;
+	EXPECT_EQ(o.K, 600);
+	EXPECT_DOUBLE_EQ(o.N_th, 0.2);
+	EXPECT_DOUBLE_EQ(o.E_th, 0.05);
+	EXPECT_EQ(o.s_x, 3);
+	EXPECT_EQ(o.s_y, 3);
+	EXPECT_EQ(o.m_x, 200);
+	EXPECT_EQ(o.m_y, 200);
+	EXPECT_NEAR(g.getResolution(), 0.05, 1e-7);	 // d_r
+	EXPECT_DOUBLE_EQ(o.d_n, 0.4);
+	EXPECT_DOUBLE_EQ(o.d_pth, 0.03);
+	EXPECT_DOUBLE_EQ(o.K_g, 0.3);
+	EXPECT_DOUBLE_EQ(o.sigma2, 0.02);
+	EXPECT_DOUBLE_EQ(o.K_n, 0.0005);
+	EXPECT_DOUBLE_EQ(o.d_min, 3);
+	EXPECT_DOUBLE_EQ(o.K_m, 0.8);
+}
+
+TEST(IniConstruction, ExampleConfigLoadsWithTableIValues)
+{
+	mrpt::config::CConfigFile cfg(std::string(GAM_SOURCE_DIR) + "/config/ground-aware-grid.ini");
+	TSetOfMetricMapInitializers inits;
+	inits.loadFromConfigFile(cfg, "map");
+	CMultiMetricMap mm(inits);
+	auto ga = mm.mapByClass<CGroundAwareOccupancyGrid>();
+	ASSERT_TRUE(ga);
+	CGroundAwareOccupancyGrid ref;
+	// Every key of the example is spelled right and holds the default.
+	auto f = ga->groundOptions.fields();
+	auto fr = ref.groundOptions.fields();
+	ASSERT_EQ(f.size(), fr.size());
+	for (size_t i = 0; i < f.size(); i++)
+	{
+		EXPECT_TRUE(cfg.keyExists("map_groundAwareGrid_00_groundOpts", f[i].key)) << f[i].key << " missing in the example";
+		const double a = std::visit([](auto* p) { return double(*p); }, f[i].var);
+		const double b = std::visit([](auto* p) { return double(*p); }, fr[i].var);
+		EXPECT_DOUBLE_EQ(a, b) << f[i].key;
+	}
+	EXPECT_TRUE(gam::ini::unknownKeys(f, cfg, "map_groundAwareGrid_00_groundOpts").empty());
+}
+
+TEST(IniConstruction, OutOfRangeValuesNameTheKey)
+{
+	struct Case
+	{
+		std::string section, key, value;
+	};
+	const std::vector<Case> bad = {
+		{"groundOpts", "K", "0"},		  {"groundOpts", "s_x", "4"},	   {"groundOpts", "N_th", "1.5"},
+		{"groundOpts", "d_pth", "-0.1"},  {"groundOpts", "K_m", "1.2"},	   {"groundOpts", "m_x", "0"},
+		{"groundOpts", "E_th", "abc"},	  {"groundOpts", "drop_rays", "maybe"},
+		{"creationOpts", "resolution", "-0.05"}};
+	for (const auto& c : bad)
+	{
+		const std::string ini = "[map]\ngroundAwareGrid_count=1\n[map_groundAwareGrid_00_" + c.section + "]\n" + c.key +
+								"=" + c.value + "\n";
+		try
+		{
+			initsFrom(ini);
+			ADD_FAILURE() << c.key << "=" << c.value << " was accepted";
+		}
+		catch (const std::exception& e)
+		{
+			const std::string msg = e.what();
+			EXPECT_NE(msg.find(c.key), std::string::npos) << msg;
+			EXPECT_NE(msg.find(c.value), std::string::npos) << msg;
+		}
+	}
+	// Elevation map too.
+	EXPECT_THROW(initsFrom("[map]\nCElevation25DMap_count=1\n[map_CElevation25DMap_00_insertOpts]\ndecimation=0\n"),
+				 std::exception);
+	EXPECT_THROW(initsFrom("[map]\nCElevation25DMap_count=1\n[map_CElevation25DMap_00_insertOpts]\nz_min=2\nz_max=1\n"),
+				 std::exception);
+}
+
+TEST(IniConstruction, SaveThenLoadGivesTheSameOptions)
+{
+	CGroundAwareOccupancyGrid a;
+	a.groundOptions.K = 123;
+	a.groundOptions.d_pth = 0.045;
+	a.groundOptions.drop_rays = false;
+	mrpt::config::CConfigFileMemory mem;
+	a.groundOptions.saveToConfigFile(mem, "g");
+	CGroundAwareOccupancyGrid b;
+	b.groundOptions.loadFromConfigFile(mem, "g");
+	EXPECT_EQ(b.groundOptions.K, 123);
+	EXPECT_DOUBLE_EQ(b.groundOptions.d_pth, 0.045);
+	EXPECT_FALSE(b.groundOptions.drop_rays);
+}
