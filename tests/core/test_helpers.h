@@ -63,6 +63,46 @@ inline void sampleSurface(
 		}
 }
 
+/** Like sampleSurface, restricted to the cells whose centre passes `keep`. */
+inline void sampleSurfaceIf(
+	const gam::ElevationGrid& grid, const std::function<bool(double, double)>& keep,
+	const std::function<double(double, double)>& z, int nPerAxis, double noise, std::mt19937& rng,
+	gam::BinnedPoints& out)
+{
+	const gam::GridGeometry& g = grid.geometry();
+	std::normal_distribution<double> N(0.0, noise > 0 ? noise : 1.0);
+	for (int cy = 0; cy < g.ny; cy++)
+		for (int cx = 0; cx < g.nx; cx++)
+		{
+			if (!keep(g.cx(cx), g.cy(cy))) continue;
+			for (int j = 0; j < nPerAxis; j++)
+				for (int i = 0; i < nPerAxis; i++)
+				{
+					const double x = g.x_min + (cx + (i + 0.5) / nPerAxis) * g.resolution;
+					const double y = g.y_min + (cy + (j + 0.5) / nPerAxis) * g.resolution;
+					grid.binPoint(x, y, float(z(x, y) + (noise > 0 ? N(rng) : 0.0)), out);
+				}
+		}
+}
+
+inline bool inRect(double x, double y, double x0, double x1, double y0, double y1)
+{
+	return x >= x0 && x < x1 && y >= y0 && y < y1;
+}
+
+/** Scene 1 (grid -5..5 m, 5 cm): floor z = 0 on [-3, 3)^2, a wall of
+ * columns 0..2 m on x in [2.5, 2.6), nothing behind it, and a 0.5 x 0.5 m
+ * box with its top at 0.4 m on [1.0, 1.5) x [0.5, 1.0). */
+struct FloorWallBox
+{
+	static bool isWall(double x, double y) { return inRect(x, y, 2.5, 2.6, -3, 3); }
+	static bool isBox(double x, double y) { return inRect(x, y, 1.0, 1.5, 0.5, 1.0); }
+	static bool isFloor(double x, double y)
+	{
+		return inRect(x, y, -3, 2.5, -3, 3) && !isBox(x, y);
+	}
+};
+
 /** Samples vertical columns (walls, box sides): every cell centre in the
  * rectangle gets points at heights z0, z0+dz, ..., z1. */
 inline void sampleColumns(
@@ -84,6 +124,30 @@ inline void insertAll(gam::ElevationGrid& grid, const gam::BinnedPoints& b)
 	gam::OutlierFilterParams f;
 	f.enabled = false;
 	grid.insert(b, f);
+}
+
+inline void buildFloorWallBox(gam::ElevationGrid& grid, std::mt19937& rng)
+{
+	gam::BinnedPoints b;
+	sampleSurfaceIf(grid, FloorWallBox::isFloor, [](double, double) { return 0.0; }, 3, 0.003, rng, b);
+	sampleSurfaceIf(grid, FloorWallBox::isBox, [](double, double) { return 0.4; }, 3, 0.003, rng, b);
+	sampleColumns(grid, 2.5, 2.6, -3, 3, 0.0, 2.0, 0.05, b);
+	insertAll(grid, b);
+}
+
+/** Scene 2: floor z = 0 for x in [-4, 1), then a 6 deg ramp up to x = 3,
+ * y in [-3, 3). */
+inline double rampHeight(double x, double deg = 6.0)
+{
+	return x < 1.0 ? 0.0 : std::tan(deg2rad(deg)) * (x - 1.0);
+}
+inline void buildRamp(gam::ElevationGrid& grid, std::mt19937& rng)
+{
+	gam::BinnedPoints b;
+	sampleSurfaceIf(
+		grid, [](double x, double y) { return inRect(x, y, -4, 3, -3, 3); },
+		[](double x, double) { return rampHeight(x); }, 3, 0.003, rng, b);
+	insertAll(grid, b);
 }
 
 }  // namespace gamtest

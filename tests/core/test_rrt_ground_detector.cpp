@@ -1,0 +1,401 @@
+// Ground-aware mapping for MRPT
+// RRT-GPD ground detection on synthetic 2.5D grids.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <random>
+#include <stdexcept>
+
+#include "gam/RrtGroundDetector.h"
+#include "test_helpers.h"
+
+using namespace gam;
+using gamtest::deg2rad;
+using gamtest::FloorWallBox;
+using gamtest::rad2deg;
+using Status = GroundDetection::Status;
+
+namespace
+{
+ElevationGrid floorWallBoxGrid()
+{
+	ElevationGrid grid;	 // -5..5 m, 5 cm
+	std::mt19937 rng(11);
+	gamtest::buildFloorWallBox(grid, rng);
+	return grid;
+}
+
+void expectSameDetection(const GroundDetection& a, const GroundDetection& b)
+{
+	ASSERT_EQ(a.status, b.status);
+	ASSERT_EQ(a.nodes.size(), b.nodes.size());
+	for (size_t i = 0; i < a.nodes.size(); i++)
+	{
+		EXPECT_EQ(a.nodes[i].x, b.nodes[i].x) << i;
+		EXPECT_EQ(a.nodes[i].y, b.nodes[i].y) << i;
+		EXPECT_EQ(a.nodes[i].z, b.nodes[i].z) << i;
+		EXPECT_EQ(a.nodes[i].parent, b.nodes[i].parent) << i;
+		EXPECT_EQ(a.nodes[i].plane_id, b.nodes[i].plane_id) << i;
+	}
+	ASSERT_EQ(a.planes.size(), b.planes.size());
+	for (size_t k = 0; k < a.planes.size(); k++)
+	{
+		EXPECT_EQ(a.planes[k].a, b.planes[k].a);
+		EXPECT_EQ(a.planes[k].b, b.planes[k].b);
+		EXPECT_EQ(a.planes[k].c, b.planes[k].c);
+		EXPECT_EQ(a.planes[k].d, b.planes[k].d);
+	}
+	EXPECT_EQ(a.plane_support, b.plane_support);
+}
+}  // namespace
+
+TEST(RrtGpdParams, ValidateRejectsOutOfRangeValues)
+{
+	EXPECT_NO_THROW(RrtGpdParams{}.validate());
+	const std::vector<std::pair<const char*, std::function<void(RrtGpdParams&)>>> bad{
+		{"K=0", [](RrtGpdParams& p) { p.iterations = 0; }},
+		{"K<0", [](RrtGpdParams& p) { p.iterations = -5; }},
+		{"N_th>1", [](RrtGpdParams& p) { p.normal_threshold = 1.5; }},
+		{"N_th=0", [](RrtGpdParams& p) { p.normal_threshold = 0; }},
+		{"E_th=0", [](RrtGpdParams& p) { p.elevation_threshold = 0; }},
+		{"E_th NaN", [](RrtGpdParams& p) { p.elevation_threshold = NAN; }},
+		{"s_x even", [](RrtGpdParams& p) { p.neighbourhood_x = 2; }},
+		{"s_y even", [](RrtGpdParams& p) { p.neighbourhood_y = 4; }},
+		{"s_x=0", [](RrtGpdParams& p) { p.neighbourhood_x = 0; }},
+		{"s_x=33", [](RrtGpdParams& p) { p.neighbourhood_x = 33; }},
+		{"s_x*s_y=1", [](RrtGpdParams& p) { p.neighbourhood_x = p.neighbourhood_y = 1; p.min_valid_cells = 3; }},
+		{"d_n=0", [](RrtGpdParams& p) { p.expansion_distance = 0; }},
+		{"max_cell_std=0", [](RrtGpdParams& p) { p.max_cell_std = 0; }},
+		{"max_fit_rms<0", [](RrtGpdParams& p) { p.max_fit_rms = -1; }},
+		{"min_valid_cells=2", [](RrtGpdParams& p) { p.min_valid_cells = 2; }},
+		{"min_valid_cells>s_x*s_y", [](RrtGpdParams& p) { p.min_valid_cells = 10; }},
+		{"seed radius 0", [](RrtGpdParams& p) { p.seed_search_radius = 0; }},
+		{"seed tol 0", [](RrtGpdParams& p) { p.seed_height_tolerance = 0; }},
+		{"seed attempts 0", [](RrtGpdParams& p) { p.seed_attempts = 0; }},
+		{"window margin 0", [](RrtGpdParams& p) { p.window_margin = 0; }},
+		{"min_nodes 2", [](RrtGpdParams& p) { p.min_nodes = 2; }},
+		{"ransac it 0", [](RrtGpdParams& p) { p.ransac_iterations = 0; }},
+		{"ransac dist 0", [](RrtGpdParams& p) { p.ransac_inlier_distance = 0; }},
+		{"max_planes 0", [](RrtGpdParams& p) { p.max_planes = 0; }},
+		{"max_planes 9", [](RrtGpdParams& p) { p.max_planes = 9; }},
+	};
+	for (const auto& [name, mutate] : bad)
+	{
+		RrtGpdParams p;
+		mutate(p);
+		EXPECT_THROW(p.validate(), std::invalid_argument) << name;
+	}
+	// Boundary values that are valid.
+	RrtGpdParams ok;
+	ok.normal_threshold = 1.0;
+	ok.neighbourhood_x = 31;
+	ok.min_nodes = 3;
+	ok.max_planes = 8;
+	EXPECT_NO_THROW(ok.validate());
+
+	// detect() validates too.
+	RrtGpdParams p;
+	p.neighbourhood_x = 2;
+	RrtGroundDetector det(p);
+	ElevationGrid grid = floorWallBoxGrid();
+	GroundDetection out;
+	EXPECT_THROW(det.detect(grid, {}, out), std::invalid_argument);
+}
+
+TEST(RrtGroundDetector, FindsFloorNotWallOrBox)
+{
+	const ElevationGrid grid = floorWallBoxGrid();
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(grid, GroundSeedHint{0, 0, 0}, out);
+	ASSERT_EQ(out.status, Status::Ok) << out.describe();
+	ASSERT_FALSE(out.planes.empty());
+	const Plane& pl = out.plane();
+	std::cout << "RRT-GPD floor+wall+box: " << out.describe() << std::endl;
+	EXPECT_LT(rad2deg(pl.tiltAngle()), 0.5);
+	EXPECT_GT(pl.c, 0.99);
+	EXPECT_NEAR(pl.heightAt(0, 0), 0.0, 0.005);
+	EXPECT_NEAR(pl.heightAt(2, 2), 0.0, 0.01);
+	// Not the wall (vertical) nor the box top (0.4 m).
+	EXPECT_LT(std::abs(pl.heightAt(1.25, 0.75)), 0.05);
+
+	ASSERT_GT(out.nodes.size(), 100u);
+	EXPECT_EQ(out.nodes.front().parent, -1);
+	EXPECT_GE(out.plane_support.front(), out.nodes.size() * 9 / 10);
+	const GridGeometry& g = grid.geometry();
+	for (size_t i = 0; i < out.nodes.size(); i++)
+	{
+		const GroundNode& n = out.nodes[i];
+		EXPECT_NEAR(n.z, 0.0, 0.01) << i;
+		EXPECT_TRUE(FloorWallBox::isFloor(n.x, n.y)) << "node " << i << " at " << n.x << "," << n.y;
+		EXPECT_FALSE(FloorWallBox::isBox(n.x, n.y));
+		EXPECT_FALSE(FloorWallBox::isWall(n.x, n.y));
+		// Node at a cell centre of an observed cell.
+		const int cx = g.ix(n.x), cy = g.iy(n.y);
+		EXPECT_NEAR(n.x, g.cx(cx), 1e-5);
+		EXPECT_NEAR(n.y, g.cy(cy), 1e-5);
+		EXPECT_TRUE(grid.cell(cx, cy).observed());
+		EXPECT_LT(rad2deg(n.local.tiltAngle()), 3.0);
+		if (i > 0)
+		{
+			ASSERT_GE(n.parent, 0);
+			ASSERT_LT(n.parent, int(i));
+			const GroundNode& p = out.nodes[size_t(n.parent)];
+			// One expansion step d_n = 0.4, snapped to a cell centre.
+			EXPECT_LE(std::hypot(n.x - p.x, n.y - p.y), 0.4 + 0.05) << i;
+		}
+	}
+	// The tree explored the floor, well beyond the robot's surroundings.
+	float xmin = 1e9f, xmax = -1e9f;
+	for (const auto& n : out.nodes) xmin = std::min(xmin, n.x), xmax = std::max(xmax, n.x);
+	EXPECT_LT(xmin, -2.0f);
+	EXPECT_GT(xmax, 2.0f);
+}
+
+TEST(RrtGroundDetector, RecoversTiltedFloor)
+{
+	ElevationGrid grid;
+	std::mt19937 rng(3);
+	gam::BinnedPoints b;
+	const double slope = std::tan(deg2rad(3.0));
+	gamtest::sampleSurfaceIf(
+		grid, [](double x, double y) { return gamtest::inRect(x, y, -3, 3, -3, 3); },
+		[slope](double x, double) { return slope * x; }, 3, 0.003, rng, b);
+	gamtest::insertAll(grid, b);
+
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(grid, GroundSeedHint{0, 0, 0}, out);
+	ASSERT_EQ(out.status, Status::Ok) << out.describe();
+	const Plane& pl = out.plane();
+	const double tiltErr = std::abs(rad2deg(pl.tiltAngle()) - 3.0);
+	const double offErr = std::abs(pl.heightAt(0, 0));
+	std::cout << "RRT-GPD tilted floor 3 deg: tilt error " << tiltErr << " deg, height error at robot "
+			  << offErr * 1000 << " mm, " << out.nodes.size() << " nodes" << std::endl;
+	EXPECT_LT(tiltErr, 0.3);
+	EXPECT_LT(offErr, 0.01);
+	// Rising along +x: the upward normal leans to -x.
+	EXPECT_LT(pl.a, -0.04);
+	EXPECT_NEAR(pl.b, 0.0, 0.01);
+	EXPECT_NEAR(pl.heightAt(2, 0), 2 * slope, 0.015);
+	for (const auto& n : out.nodes) EXPECT_NEAR(n.z, slope * n.x, 0.01);
+}
+
+TEST(RrtGroundDetector, FitLocalPlane)
+{
+	// Noise-free 3 deg floor on a 10 x 10 patch; wall columns at x in [0.3, 0.35).
+	ElevationGrid grid(gamtest::makeGeometry(0, 0, 0.05, 20, 20));
+	std::mt19937 rng(1);
+	gam::BinnedPoints b;
+	const double slope = std::tan(deg2rad(3.0));
+	gamtest::sampleSurfaceIf(
+		grid, [](double x, double y) { return x < 0.5 && y < 0.5 && !(x >= 0.3 && x < 0.35); },
+		[slope](double x, double) { return slope * x; }, 2, 0.0, rng, b);
+	gamtest::sampleColumns(grid, 0.3, 0.35, 0, 0.5, 0.0, 1.0, 0.1, b);
+	gamtest::insertAll(grid, b);
+
+	RrtGroundDetector det;
+	Plane pl;
+	double rms = -1;
+	ASSERT_TRUE(det.fitLocalPlane(grid, 2, 2, pl, rms));
+	EXPECT_NEAR(rad2deg(pl.tiltAngle()), 3.0, 1e-3);
+	EXPECT_NEAR(rms, 0.0, 1e-5);
+	// Expressed in grid coordinates: the height at the cell centre (0.125, 0.125).
+	EXPECT_NEAR(pl.heightAt(0.125, 0.125), slope * 0.125, 1e-5);
+	EXPECT_NEAR(pl.heightAt(1.0, 0.0), slope * 1.0, 1e-4);
+
+	// Corner of the patch: 4 cells < min_valid_cells (5).
+	EXPECT_FALSE(det.fitLocalPlane(grid, 0, 0, pl, rms));
+	// Next to the wall column (cx = 6): the wall cells (std 0.3 m) are left out,
+	// so the fit on the remaining 6 floor cells is still exact.
+	ASSERT_TRUE(det.fitLocalPlane(grid, 5, 4, pl, rms));
+	EXPECT_NEAR(rms, 0.0, 1e-5);
+	EXPECT_NEAR(rad2deg(pl.tiltAngle()), 3.0, 1e-3);
+	// Centred on the wall: only the 2 x 3 floor cells at x = 5 and 7 are left:
+	// still 6 cells.
+	ASSERT_TRUE(det.fitLocalPlane(grid, 6, 4, pl, rms));
+	EXPECT_NEAR(rad2deg(pl.tiltAngle()), 3.0, 1e-3);
+	// Far outside the data.
+	EXPECT_FALSE(det.fitLocalPlane(grid, 15, 15, pl, rms));
+}
+
+TEST(RrtGroundDetector, NoFloorNearExpectedHeight)
+{
+	// A large table top at 1.0 m and nothing else: the robot expects the floor
+	// at 0 (+-0.3 m) -> no valid seed.
+	ElevationGrid grid;
+	std::mt19937 rng(5);
+	gam::BinnedPoints b;
+	gamtest::sampleSurface(grid, -2, 2, -2, 2, [](double, double) { return 1.0; }, 3, 0.003, rng, b);
+	gamtest::insertAll(grid, b);
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(grid, GroundSeedHint{0, 0, 0}, out);
+	EXPECT_EQ(out.status, Status::NoValidSeed);
+	EXPECT_FALSE(out.ok());
+	EXPECT_TRUE(out.planes.empty());
+	EXPECT_TRUE(out.nodes.empty());
+	// Expected at 1.0, the same grid is a floor.
+	det.detect(grid, GroundSeedHint{0, 0, 1.0}, out);
+	EXPECT_EQ(out.status, Status::Ok) << out.describe();
+	EXPECT_NEAR(out.plane().heightAt(0, 0), 1.0, 0.01);
+
+	// Only walls (vertical columns): nothing planar at all.
+	ElevationGrid walls;
+	b.clear();
+	gamtest::sampleColumns(walls, -2, 2, 1.0, 1.1, 0, 2, 0.05, b);
+	gamtest::sampleColumns(walls, 1.0, 1.1, -2, 2, 0, 2, 0.05, b);
+	gamtest::insertAll(walls, b);
+	det.detect(walls, GroundSeedHint{0, 0, 0}, out);
+	EXPECT_EQ(out.status, Status::NoValidSeed);
+
+	// A floor beyond seed_search_radius (5 m) from the robot.
+	ElevationGrid farFloor;
+	b.clear();
+	gamtest::sampleSurface(farFloor, 3, 5, 3, 5, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
+	gamtest::insertAll(farFloor, b);
+	det.detect(farFloor, GroundSeedHint{-3, -3, 0}, out);
+	EXPECT_EQ(out.status, Status::NoValidSeed);
+	det.detect(farFloor, GroundSeedHint{1, 1, 0}, out);  // 2.8 m away: found
+	EXPECT_EQ(out.status, Status::Ok) << out.describe();
+}
+
+TEST(RrtGroundDetector, EmptyGridAndTinyFloorPatch)
+{
+	ElevationGrid grid;
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(grid, {}, out);
+	EXPECT_EQ(out.status, Status::EmptyGrid);
+
+	// A 3 x 3 cell patch (15 cm): at most 5 cells have >= 5 valid neighbours,
+	// fewer than min_nodes = 8.
+	std::mt19937 rng(2);
+	gam::BinnedPoints b;
+	gamtest::sampleSurface(grid, -0.08, 0.06, -0.08, 0.06, [](double, double) { return 0.0; }, 3, 0.002, rng, b);
+	gamtest::insertAll(grid, b);
+	ASSERT_EQ(grid.observedCount(), 9u);
+	det.detect(grid, {}, out);
+	EXPECT_EQ(out.status, Status::TooFewNodes);
+	EXPECT_LT(out.nodes.size(), 8u);
+	EXPECT_GE(out.nodes.size(), 1u);
+	EXPECT_TRUE(out.planes.empty());
+	EXPECT_STREQ(GroundDetection::statusName(out.status), "too_few_nodes");
+
+	// The same patch with min_nodes 3 is enough.
+	RrtGpdParams p;
+	p.min_nodes = 3;
+	p.iterations = 20000;  // samples rarely fall on such a small patch
+	det.setParams(p);
+	det.detect(grid, {}, out);
+	EXPECT_EQ(out.status, Status::Ok) << out.describe();
+}
+
+TEST(RrtGroundDetector, RetriesFromFloorWhenSeededOnABoxTop)
+{
+	// Floor everywhere, a 3 x 3 cell box top at 0.2 m right under the hint.
+	ElevationGrid grid;
+	std::mt19937 rng(8);
+	gam::BinnedPoints b;
+	auto isBox = [](double x, double y) { return gamtest::inRect(x, y, -0.08, 0.06, -0.08, 0.06); };
+	gamtest::sampleSurfaceIf(
+		grid, [&](double x, double y) { return gamtest::inRect(x, y, -3, 3, -3, 3) && !isBox(x, y); },
+		[](double, double) { return 0.0; }, 3, 0.003, rng, b);
+	gamtest::sampleSurfaceIf(grid, isBox, [](double, double) { return 0.2; }, 3, 0.003, rng, b);
+	gamtest::insertAll(grid, b);
+
+	const GroundSeedHint hint{-0.025, -0.025, 0.1};	// box centre; 0 and 0.2 within +-0.3
+	RrtGpdParams p;
+	p.seed_attempts = 1;
+	RrtGroundDetector one(p);
+	GroundDetection out;
+	one.detect(grid, hint, out);
+	EXPECT_EQ(out.status, Status::TooFewNodes) << out.describe();
+	ASSERT_FALSE(out.nodes.empty());
+	EXPECT_NEAR(out.nodes.front().z, 0.2, 0.01);  // the box top was the seed
+
+	RrtGroundDetector retry;  // default: 3 attempts
+	retry.detect(grid, hint, out);
+	ASSERT_EQ(out.status, Status::Ok) << out.describe();
+	EXPECT_NEAR(out.plane().heightAt(0, 0), 0.0, 0.01);
+	for (const auto& n : out.nodes) EXPECT_NEAR(n.z, 0.0, 0.01);
+}
+
+TEST(RrtGroundDetector, DeterministicForTheSameSeed)
+{
+	const ElevationGrid grid = floorWallBoxGrid();
+	RrtGpdParams p;
+	p.random_seed = 1234;
+	RrtGroundDetector d1(p), d2(p);
+	GroundDetection a, b, c;
+	d1.detect(grid, {0, 0, 0}, a);
+	d2.detect(grid, {0, 0, 0}, b);
+	d1.detect(grid, {0, 0, 0}, c);	// reuse of the same detector (scratch state)
+	ASSERT_EQ(a.status, Status::Ok);
+	expectSameDetection(a, b);
+	expectSameDetection(a, c);
+
+	// Another seed grows another tree (same floor).
+	p.random_seed = 99;
+	RrtGroundDetector d3(p);
+	GroundDetection e;
+	d3.detect(grid, {0, 0, 0}, e);
+	ASSERT_EQ(e.status, Status::Ok);
+	bool differ = e.nodes.size() != a.nodes.size();
+	for (size_t i = 0; !differ && i < a.nodes.size(); i++)
+		differ = a.nodes[i].x != e.nodes[i].x || a.nodes[i].y != e.nodes[i].y;
+	EXPECT_TRUE(differ);
+	EXPECT_NEAR(e.plane().heightAt(0, 0), 0.0, 0.005);
+}
+
+TEST(RrtGroundDetector, RampBecomesAnExtraPlane)
+{
+	ElevationGrid grid;
+	std::mt19937 rng(21);
+	gamtest::buildRamp(grid, rng);
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(grid, {0, 0, 0}, out);
+	ASSERT_EQ(out.status, Status::Ok) << out.describe();
+	std::cout << "RRT-GPD floor+6 deg ramp: " << out.describe() << std::endl;
+	ASSERT_GE(out.planes.size(), 2u);
+	ASSERT_EQ(out.plane_support.size(), out.planes.size());
+	// planes[0]: the floor.
+	EXPECT_LT(rad2deg(out.plane().tiltAngle()), 0.5);
+	EXPECT_NEAR(out.plane().heightAt(-1, 0), 0.0, 0.01);
+	// One of the extra planes is the ramp: 6 deg, z(2) = tan 6 deg = 0.105.
+	int ramp = -1;
+	for (size_t k = 1; k < out.planes.size(); k++)
+		if (std::abs(rad2deg(out.planes[k].tiltAngle()) - 6.0) < 0.5) ramp = int(k);
+	ASSERT_GE(ramp, 1);
+	const Plane& rp = out.planes[size_t(ramp)];
+	EXPECT_NEAR(rp.heightAt(2.0, 0.0), gamtest::rampHeight(2.0), 0.01);
+	EXPECT_NEAR(rp.heightAt(2.5, 1.0), gamtest::rampHeight(2.5), 0.01);
+	EXPECT_GE(out.plane_support[size_t(ramp)], RrtGpdParams{}.min_nodes_per_extra_plane);
+	// The tree climbed the ramp; its nodes up there belong to the ramp plane.
+	size_t high = 0;
+	for (const auto& n : out.nodes)
+	{
+		EXPECT_NEAR(n.z, gamtest::rampHeight(n.x), 0.01);
+		if (n.x > 1.8)
+		{
+			high++;
+			EXPECT_EQ(n.plane_id, ramp) << n.x << "," << n.y;
+		}
+	}
+	EXPECT_GT(high, 10u);
+
+	// Extra planes disabled: the ramp is not a plane.
+	RrtGpdParams p;
+	p.min_nodes_per_extra_plane = 0;
+	det.setParams(p);
+	det.detect(grid, {0, 0, 0}, out);
+	ASSERT_EQ(out.status, Status::Ok);
+	EXPECT_EQ(out.planes.size(), 1u);
+	p = RrtGpdParams{};
+	p.max_planes = 1;
+	det.setParams(p);
+	det.detect(grid, {0, 0, 0}, out);
+	EXPECT_EQ(out.planes.size(), 1u);
+}
