@@ -1,0 +1,124 @@
+// ground-aware-mapper: builds the ground-aware grid and the comparison maps
+// from a rawlog. All the work is in libs/mapper (gam::mapper::Mapper).
+#include <default_config.h>
+#include <gam/mapper/Mapper.h>
+#include <mrpt/3rdparty/tclap/CmdLine.h>
+#include <mrpt/maps/registerGroundAwareMaps.h>
+
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace
+{
+constexpr const char* kApp = "ground-aware-mapper";
+
+/** Keeps TCLAP's parse error for our one-line message instead of its usage dump. */
+class QuietFailureOutput : public TCLAP::StdOutput
+{
+   public:
+	std::string error;
+	void failure(TCLAP::CmdLineInterface&, TCLAP::ArgException& e) override
+	{
+		error = e.argId() + ": " + e.error();
+	}
+};
+
+int fail(int code, std::string msg)
+{
+	for (auto& c : msg)
+		if (c == '\n' || c == '\r') c = ' ';
+	std::cerr << kApp << ": error: " << msg << std::endl;
+	return code;
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+	mrpt::maps::registerGroundAwareMaps();
+	gam::mapper::MapperOptions o;
+	try
+	{
+		TCLAP::CmdLine cmd(
+			"Ground-aware 2D occupancy mapping from a rawlog (depth cameras, 2D scans). Writes, for every "
+			"2D grid of the .ini, <label>.yaml/.pgm (ROS map_server), <label>.gridmap.gz and <label>.png, "
+			"plus the elevation map, ground_planes.csv and timing.csv into --out.",
+			' ', "0.1.0");
+		TCLAP::ValueArg<std::string> aRawlog("r", "rawlog", "input rawlog (either format)", false, "", "FILE.rawlog", cmd);
+		TCLAP::ValueArg<std::string> aOut("o", "out", "output directory (created if missing)", false, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> aConfig(
+			"c", "config", "map configuration (.ini); default: the embedded config/ground-aware-mapper.ini", false,
+			"", "FILE.ini", cmd);
+		TCLAP::ValueArg<std::string> aSection(
+			"s", "section", "section of the .ini with the <map>_count keys", false, "map", "NAME", cmd);
+		TCLAP::SwitchArg aPrint("", "print-default-config", "print the embedded default .ini and exit", cmd);
+		TCLAP::SwitchArg aLocal(
+			"", "local-map", "robot-centred local maps: every 2D grid is kept as a window that follows the robot", cmd);
+		TCLAP::ValueArg<int> aLocalCells(
+			"", "local-size-cells", "side of the local window in cells (with --local-map)", false, 600, "N", cmd);
+		TCLAP::ValueArg<long> aMaxFrames("n", "max-frames", "stop after N frames (0 = all)", false, 0, "N", cmd);
+		TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line on stderr", cmd);
+		QuietFailureOutput out;
+		cmd.setOutput(&out);
+		if (!cmd.parse(argc, argv))
+		{
+			if (!out.error.empty()) return fail(2, out.error + " (see --help)");
+			return 0;  // --help / --version
+		}
+
+		if (aPrint.getValue())
+		{
+			std::cout << kDefaultConfigIni << std::flush;
+			return 0;
+		}
+		if (aRawlog.getValue().empty()) return fail(2, "missing --rawlog FILE.rawlog (see --help)");
+		if (aOut.getValue().empty()) return fail(2, "missing --out DIR (see --help)");
+		if (aMaxFrames.getValue() < 0) return fail(2, "--max-frames must be >= 0");
+		o.rawlogPath = aRawlog.getValue();
+		o.outDir = aOut.getValue();
+		o.section = aSection.getValue();
+		o.localMap = aLocal.getValue();
+		o.localCells = aLocalCells.getValue();
+		o.maxFrames = size_t(aMaxFrames.getValue());
+		o.progress = !aQuiet.getValue();
+		if (aConfig.getValue().empty())
+		{
+			o.configText = kDefaultConfigIni;
+			o.configName = "embedded default config";
+		}
+		else
+		{
+			std::ifstream f(aConfig.getValue(), std::ios::binary);
+			if (!f) return fail(2, "cannot read config file " + aConfig.getValue());
+			std::ostringstream ss;
+			ss << f.rdbuf();
+			o.configText = ss.str();
+			o.configName = aConfig.getValue();
+		}
+	}
+	catch (TCLAP::ArgException& e)
+	{
+		return fail(2, e.argId() + ": " + e.error() + " (see --help)");
+	}
+
+	try
+	{
+		gam::mapper::Mapper mapper(o);
+		const auto s = mapper.run();
+		std::cout << kApp << ": " << s.text() << "outputs: " << s.files.size() << " files in " << o.outDir
+				  << std::endl;
+		return 0;
+	}
+	catch (const gam::mapper::ConfigError& e)
+	{
+		return fail(2, e.what());
+	}
+	catch (const gam::mapper::RunError& e)
+	{
+		return fail(1, e.what());
+	}
+	catch (const std::exception& e)
+	{
+		return fail(1, e.what());
+	}
+}

@@ -1,0 +1,78 @@
+// Ground-aware mapping for MRPT
+// Writers (and small readers, for tests and tools) of the 2D-grid outputs of
+// ground-aware-mapper: ROS map_server YAML + PGM, .gridmap.gz, PNG.
+#pragma once
+
+#include <mrpt/maps/COccupancyGridMap2D.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace gam::mapper
+{
+/** PGM grey level of a cell: round(255 * (1 - p_occupied)) = round(255 * p_free),
+ * p_free = COccupancyGridMap2D::l2p(cell). */
+uint8_t pgmValue(mrpt::maps::COccupancyGridMap2D::cellType cell);
+
+/** Writes `<pgmPath>` (binary P5, first row = highest y) and `<yamlPath>`
+ * (ROS map_server: image = `imageName`, mode scale, negate 0, origin = lower-left
+ * corner). Throws std::runtime_error on I/O errors. */
+void writeRosMap(
+	const mrpt::maps::COccupancyGridMap2D& grid, const std::string& yamlPath,
+	const std::string& pgmPath, const std::string& imageName);
+
+/** A plain COccupancyGridMap2D copy of `grid` (also of derived classes),
+ * gzip-serialized: stock MRPT reads it with
+ * `archiveFrom(CFileGZInputStream(f)) >> COccupancyGridMap2D`. */
+void writePlainGridmapGz(const mrpt::maps::COccupancyGridMap2D& grid, const std::string& path);
+
+/** The part of a grid a PNG shows: cells [cx0, cx0+w) x [cy0, cy0+h), each
+ * drawn as scale x scale pixels; pixel (px, py) shows cell
+ * (cx0 + px/scale, cy0 + h-1 - py/scale) (+y up). */
+struct PngView
+{
+	int cx0 = 0, cy0 = 0, w = 0, h = 0, scale = 1;
+};
+/** The bounding box of the observed cells (log-odds != 0) plus 1 m, clamped to
+ * the grid (the whole grid if nothing was observed), scaled up by an integer
+ * factor (<= 8) towards ~600 px. */
+PngView pngViewOf(const mrpt::maps::COccupancyGridMap2D& grid);
+
+/** RGB picture of pngViewOf(grid): grey = the PGM value of the cell; cells never
+ * observed (log-odds exactly 0) are light blue (kUnknown*). */
+void writeGridPng(const mrpt::maps::COccupancyGridMap2D& grid, const std::string& path);
+constexpr uint8_t kUnknownR = 190, kUnknownG = 205, kUnknownB = 235;
+
+/** A plain copy (slices a derived grid). */
+mrpt::maps::COccupancyGridMap2D plainCopy(const mrpt::maps::COccupancyGridMap2D& grid);
+
+/** Crops / extends `grid` to a window of n x n cells centred on (cx, cy),
+ * keeping the cell alignment and the log-odds of the cells inside; new cells
+ * are unknown. Returns true if the grid changed. */
+bool recentreGrid(mrpt::maps::COccupancyGridMap2D& grid, double cx, double cy, int n);
+
+// --------------------------------------------------------------- readers
+struct PgmImage
+{
+	int width = 0, height = 0, maxval = 0;
+	std::vector<uint8_t> pixels;  ///< row-major, first row first
+	uint8_t at(int x, int row) const { return pixels[size_t(row) * size_t(width) + size_t(x)]; }
+};
+/** Reads a binary (P5) PGM; throws std::runtime_error. */
+PgmImage readPgm(const std::string& path);
+
+struct RosMapYaml
+{
+	std::string image, mode;
+	double resolution = 0, origin_x = 0, origin_y = 0, origin_yaw = 0;
+	int negate = -1;
+	double occupied_thresh = -1, free_thresh = -1;
+};
+/** Reads the keys of a map_server YAML; throws std::runtime_error if one is missing. */
+RosMapYaml readRosYaml(const std::string& path);
+
+/** Reads a .gridmap / .gridmap.gz as a stock COccupancyGridMap2D. */
+mrpt::maps::COccupancyGridMap2D readGridmapGz(const std::string& path);
+
+}  // namespace gam::mapper

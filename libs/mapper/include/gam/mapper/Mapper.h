@@ -1,0 +1,97 @@
+// Ground-aware mapping for MRPT
+// The engine of ground-aware-mapper: builds a CMultiMetricMap from an .ini
+// (MRPT's [map]-style sections, validated), streams a rawlog into it map by
+// map with per-map timing, and writes the output files atomically.
+#pragma once
+
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/maps/CMultiMetricMap.h>
+#include <mrpt/maps/TMetricMapInitializer.h>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace gam::mapper
+{
+/** Bad command line or configuration (exit code 2). */
+struct ConfigError : std::runtime_error
+{
+	using std::runtime_error::runtime_error;
+};
+/** Bad input data or output failure (exit code 1). */
+struct RunError : std::runtime_error
+{
+	using std::runtime_error::runtime_error;
+};
+
+struct MapperOptions
+{
+	std::string rawlogPath;
+	std::string outDir;
+	std::string configText;	 ///< the .ini contents
+	std::string configName = "config";	///< for messages
+	std::string section = "map";
+	bool localMap = false;
+	int localCells = 600;
+	size_t maxFrames = 0;  ///< 0 = all
+	bool progress = true;
+};
+
+/** One map of the .ini, in CMultiMetricMap order. */
+struct MapSpec
+{
+	std::string iniName;  ///< the name as spelled in `<iniName>_count`
+	unsigned index = 0;
+	std::string prefix;	 ///< `<section>_<iniName>_NN`
+	std::string className;	///< RTTI name
+	std::string label;	///< output file name stem
+};
+
+/** Parses and validates the map definitions in `section` (the same order and
+ * sections as TSetOfMetricMapInitializers::loadFromConfigFile), rejecting
+ * unknown map types, unknown keys / sections of this project's map classes,
+ * out-of-range values and bad or duplicate labels. Throws ConfigError. */
+void loadMapDefinitions(
+	const mrpt::config::CConfigFileBase& ini, const std::string& section,
+	mrpt::maps::TSetOfMetricMapInitializers& inits, std::vector<MapSpec>& specs);
+
+struct MapTiming
+{
+	std::string label, className;
+	std::vector<double> totalMs;  ///< per frame
+	double median() const;
+	double p95() const;
+};
+
+struct RunSummary
+{
+	size_t frames = 0, frames3D = 0, frames2D = 0, framesWithoutOdometry = 0;
+	double seconds = 0;
+	std::vector<MapTiming> maps;
+	std::vector<std::string> files;	 ///< written, relative to outDir
+	std::string text() const;
+};
+
+double percentile(std::vector<double> v, double p);
+
+class Mapper
+{
+   public:
+	/** Parses the configuration and creates the maps. Throws ConfigError. */
+	explicit Mapper(const MapperOptions& opts);
+	/** Runs over the rawlog and writes the outputs. Throws RunError. */
+	RunSummary run();
+
+	mrpt::maps::CMultiMetricMap& maps() { return m_maps; }
+	const std::vector<MapSpec>& specs() const { return m_specs; }
+
+   private:
+	void writeMaps(const std::string& tmpDir, RunSummary& s);
+	MapperOptions m_opts;
+	mrpt::maps::CMultiMetricMap m_maps;
+	std::vector<MapSpec> m_specs;
+	mrpt::poses::CPose3D m_lastPose;
+};
+
+}  // namespace gam::mapper

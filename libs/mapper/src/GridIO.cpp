@@ -1,0 +1,247 @@
+#include <gam/mapper/GridIO.h>
+#include <mrpt/img/CImage.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+namespace gam::mapper
+{
+using mrpt::maps::COccupancyGridMap2D;
+
+uint8_t pgmValue(COccupancyGridMap2D::cellType cell)
+{
+	const double pFree = double(COccupancyGridMap2D::l2p(cell));
+	return uint8_t(std::clamp<long>(std::lround(255.0 * pFree), 0, 255));
+}
+
+void writeRosMap(
+	const COccupancyGridMap2D& g, const std::string& yamlPath, const std::string& pgmPath,
+	const std::string& imageName)
+{
+	const int W = int(g.getSizeX()), H = int(g.getSizeY());
+	{
+		std::ofstream f(pgmPath, std::ios::binary);
+		if (!f) throw std::runtime_error("cannot write " + pgmPath);
+		f << "P5\n# ground-aware-mapper: pixel = round(255*(1-p_occupied)), first row = highest y\n"
+		  << W << " " << H << "\n255\n";
+		std::vector<char> row(static_cast<size_t>(W));
+		for (int r = 0; r < H; r++)
+		{
+			const auto* src = g.getRow(H - 1 - r);
+			for (int x = 0; x < W; x++) row[size_t(x)] = char(pgmValue(src[x]));
+			f.write(row.data(), W);
+		}
+		f.flush();
+		if (!f) throw std::runtime_error("cannot write " + pgmPath);
+	}
+	std::ofstream y(yamlPath);
+	if (!y) throw std::runtime_error("cannot write " + yamlPath);
+	y << std::setprecision(9);
+	y << "image: " << imageName << "\n"
+	  << "mode: scale\n"
+	  << "resolution: " << g.getResolution() << "\n"
+	  << "origin: [" << g.getXMin() << ", " << g.getYMin() << ", 0.0]\n"
+	  << "negate: 0\n"
+	  << "occupied_thresh: 0.65\n"
+	  << "free_thresh: 0.196\n";
+	y.flush();
+	if (!y) throw std::runtime_error("cannot write " + yamlPath);
+}
+
+COccupancyGridMap2D plainCopy(const COccupancyGridMap2D& g) { return COccupancyGridMap2D(g); }
+
+void writePlainGridmapGz(const COccupancyGridMap2D& g, const std::string& path)
+{
+	const COccupancyGridMap2D plain = plainCopy(g);
+	mrpt::io::CFileGZOutputStream f;
+	if (!f.open(path, 6)) throw std::runtime_error("cannot write " + path);
+	auto ar = mrpt::serialization::archiveFrom(f);
+	ar << plain;
+	f.close();
+}
+
+PngView pngViewOf(const COccupancyGridMap2D& g)
+{
+	const int W = int(g.getSizeX()), H = int(g.getSizeY());
+	int x0 = W, x1 = -1, y0 = H, y1 = -1;
+	for (int y = 0; y < H; y++)
+	{
+		const auto* row = g.getRow(y);
+		for (int x = 0; x < W; x++)
+			if (row[x] != 0)
+			{
+				x0 = std::min(x0, x);
+				x1 = std::max(x1, x);
+				y0 = std::min(y0, y);
+				y1 = std::max(y1, y);
+			}
+	}
+	PngView v;
+	if (x1 < 0)
+	{
+		v.w = W;
+		v.h = H;
+	}
+	else
+	{
+		const int m = std::max(1, int(std::ceil(1.0 / g.getResolution())));
+		v.cx0 = std::max(0, x0 - m);
+		v.cy0 = std::max(0, y0 - m);
+		v.w = std::min(W - 1, x1 + m) - v.cx0 + 1;
+		v.h = std::min(H - 1, y1 + m) - v.cy0 + 1;
+	}
+	v.scale = std::clamp(600 / std::max(1, std::max(v.w, v.h)), 1, 8);
+	return v;
+}
+
+void writeGridPng(const COccupancyGridMap2D& g, const std::string& path)
+{
+	const PngView v = pngViewOf(g);
+	const int k = v.scale;
+	mrpt::img::CImage im(v.w * k, v.h * k, mrpt::img::CH_RGB);
+	for (int r = 0; r < v.h; r++)
+	{
+		const auto* src = g.getRow(v.cy0 + v.h - 1 - r);
+		for (int x = 0; x < v.w; x++)
+		{
+			const auto cell = src[v.cx0 + x];
+			mrpt::img::TColor c(kUnknownR, kUnknownG, kUnknownB);
+			if (cell != 0)
+			{
+				const uint8_t p = pgmValue(cell);
+				c = mrpt::img::TColor(p, p, p);
+			}
+			for (int dy = 0; dy < k; dy++)
+				for (int dx = 0; dx < k; dx++) im.setPixel(x * k + dx, r * k + dy, c);
+		}
+	}
+	if (!im.saveToFile(path)) throw std::runtime_error("cannot write " + path);
+}
+
+bool recentreGrid(COccupancyGridMap2D& g, double cx, double cy, int n)
+{
+	const double res = g.getResolution();
+	const double ox = g.getXMin(), oy = g.getYMin();
+	const long sx = std::lround((cx - 0.5 * n * res - ox) / res);
+	const long sy = std::lround((cy - 0.5 * n * res - oy) / res);
+	if (sx == 0 && sy == 0 && int(g.getSizeX()) == n && int(g.getSizeY()) == n) return false;
+	const COccupancyGridMap2D old = plainCopy(g);
+	const float nx0 = float(ox + sx * res), ny0 = float(oy + sy * res);
+	g.setSize(nx0, float(nx0 + n * res), ny0, float(ny0 + n * res), float(res), 0.5f);
+	const int W = int(g.getSizeX()), H = int(g.getSizeY());
+	const int oW = int(old.getSizeX()), oH = int(old.getSizeY());
+	for (int y = 0; y < H; y++)
+	{
+		const long oyIdx = long(y) + sy;
+		if (oyIdx < 0 || oyIdx >= oH) continue;
+		auto* dst = g.getRow(y);
+		const auto* src = old.getRow(int(oyIdx));
+		for (int x = 0; x < W; x++)
+		{
+			const long oxIdx = long(x) + sx;
+			if (oxIdx >= 0 && oxIdx < oW) dst[x] = src[oxIdx];
+		}
+	}
+	return true;
+}
+
+// ---------------------------------------------------------------------------
+PgmImage readPgm(const std::string& path)
+{
+	std::ifstream f(path, std::ios::binary);
+	if (!f) throw std::runtime_error("cannot open " + path);
+	auto token = [&]() {
+		std::string t;
+		char c;
+		while (f.get(c))
+		{
+			if (c == '#')
+			{
+				std::string dummy;
+				std::getline(f, dummy);
+				continue;
+			}
+			if (std::isspace((unsigned char)c))
+			{
+				if (!t.empty()) break;
+				continue;
+			}
+			t += c;
+		}
+		return t;
+	};
+	PgmImage im;
+	if (token() != "P5") throw std::runtime_error(path + ": not a binary PGM (P5)");
+	im.width = std::stoi(token());
+	im.height = std::stoi(token());
+	im.maxval = std::stoi(token());
+	if (im.width <= 0 || im.height <= 0 || im.maxval != 255)
+		throw std::runtime_error(path + ": bad PGM header");
+	im.pixels.resize(size_t(im.width) * size_t(im.height));
+	f.read(reinterpret_cast<char*>(im.pixels.data()), std::streamsize(im.pixels.size()));
+	if (f.gcount() != std::streamsize(im.pixels.size())) throw std::runtime_error(path + ": truncated PGM");
+	return im;
+}
+
+RosMapYaml readRosYaml(const std::string& path)
+{
+	std::ifstream f(path);
+	if (!f) throw std::runtime_error("cannot open " + path);
+	RosMapYaml y;
+	std::string line;
+	bool hasRes = false, hasOrigin = false;
+	while (std::getline(f, line))
+	{
+		const auto c = line.find(':');
+		if (c == std::string::npos) continue;
+		std::string k = line.substr(0, c), v = line.substr(c + 1);
+		auto trim = [](std::string s) {
+			while (!s.empty() && std::isspace((unsigned char)s.back())) s.pop_back();
+			size_t i = 0;
+			while (i < s.size() && std::isspace((unsigned char)s[i])) i++;
+			return s.substr(i);
+		};
+		k = trim(k);
+		v = trim(v);
+		if (k == "image") y.image = v;
+		else if (k == "mode") y.mode = v;
+		else if (k == "resolution") y.resolution = std::stod(v), hasRes = true;
+		else if (k == "negate") y.negate = std::stoi(v);
+		else if (k == "occupied_thresh") y.occupied_thresh = std::stod(v);
+		else if (k == "free_thresh") y.free_thresh = std::stod(v);
+		else if (k == "origin")
+		{
+			if (v.size() < 2 || v.front() != '[' || v.back() != ']')
+				throw std::runtime_error(path + ": bad origin");
+			std::string in = v.substr(1, v.size() - 2);
+			for (auto& ch : in)
+				if (ch == ',') ch = ' ';
+			std::istringstream ss(in);
+			if (!(ss >> y.origin_x >> y.origin_y >> y.origin_yaw)) throw std::runtime_error(path + ": bad origin");
+			hasOrigin = true;
+		}
+	}
+	if (y.image.empty() || y.mode.empty() || !hasRes || !hasOrigin || y.negate < 0 || y.occupied_thresh < 0 ||
+		y.free_thresh < 0)
+		throw std::runtime_error(path + ": missing map_server keys");
+	return y;
+}
+
+COccupancyGridMap2D readGridmapGz(const std::string& path)
+{
+	mrpt::io::CFileGZInputStream f;
+	if (!f.open(path)) throw std::runtime_error("cannot open " + path);
+	COccupancyGridMap2D g;
+	auto ar = mrpt::serialization::archiveFrom(f);
+	ar >> g;
+	return g;
+}
+
+}  // namespace gam::mapper
