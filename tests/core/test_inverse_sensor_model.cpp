@@ -1,0 +1,544 @@
+// Ground-aware mapping for MRPT
+// Inverse sensor model: the formulas by hand, then end to end on synthetic
+// frames with a hand-made (or detected) ground.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+#include <stdexcept>
+
+#include "gam/InverseSensorModel.h"
+#include "gam/RrtGroundDetector.h"
+#include "test_helpers.h"
+
+using namespace gam;
+using gamtest::deg2rad;
+using gamtest::inRect;
+
+namespace
+{
+/** P(occ) of an obstacle/drop voxel, eq. (4)-(5) written out with the
+ * paper's constants (K_n = 0.0005, d_min = 3, K_m = 0.8). */
+double handObstacleP(int n, double span, double res)
+{
+	const double rho = n / (res * res * std::max(span, res));
+	const double pr = 1.0 / (1.0 + std::exp(-(0.0005 * rho - 3.0)));
+	return 0.5 + 0.4 * pr;
+}
+
+ElevationCell cellOf(std::initializer_list<float> zs)
+{
+	ElevationCell c;
+	for (float z : zs) c.add(z);
+	return c;
+}
+
+GroundDetection handDetection(const Plane& pl, GroundDetection::Status s = GroundDetection::Status::Ok)
+{
+	GroundDetection d;
+	d.status = s;
+	d.planes.push_back(pl);
+	d.plane_support.push_back(100);
+	return d;
+}
+const Plane kFloor{0, 0, 1, 0};	 // z = 0
+
+/** Consistency of evidence() and evidenceCells(). */
+void checkEvidenceBookkeeping(const InverseSensorModel& ism)
+{
+	std::set<uint32_t> cells(ism.evidenceCells().begin(), ism.evidenceCells().end());
+	EXPECT_EQ(cells.size(), ism.evidenceCells().size()) << "duplicates in evidenceCells()";
+	size_t nonNeutral = 0;
+	for (size_t i = 0; i < ism.evidence().size(); i++)
+		if (ism.evidence()[i] != 0.5f)
+		{
+			nonNeutral++;
+			EXPECT_TRUE(cells.count(uint32_t(i))) << i;
+		}
+	EXPECT_EQ(nonNeutral, cells.size());
+}
+}  // namespace
+
+TEST(IsmFormulas, VoxelDensity)
+{
+	// N / (d_r^2 * max(span, d_r))
+	EXPECT_NEAR(ism::voxelDensity(10, 0.2, 0.05), 10 / (0.0025 * 0.2), 1e-6);	// 20000
+	EXPECT_NEAR(ism::voxelDensity(5, 0.01, 0.05), 40000.0, 1e-6);  // span < d_r -> d_r
+	EXPECT_NEAR(ism::voxelDensity(1, 0.0, 0.1), 1000.0, 1e-9);
+	EXPECT_EQ(ism::voxelDensity(0, 0.3, 0.05), 0.0);
+}
+
+TEST(IsmFormulas, DensityConfidence)
+{
+	const IsmParams p;	// K_n = 0.0005, d_min = 3
+	EXPECT_DOUBLE_EQ(p.K_n, 0.0005);
+	EXPECT_DOUBLE_EQ(p.d_min, 3.0);
+	EXPECT_NEAR(ism::densityConfidence(6000, p), 0.5, 1e-12);  // K_n rho = d_min
+	EXPECT_NEAR(ism::densityConfidence(10000, p), 0.8807970779778823, 1e-12);	 // 1/(1+e^-2)
+	EXPECT_NEAR(ism::densityConfidence(0, p), 0.04742587317756678, 1e-12);  // 1/(1+e^3)
+	EXPECT_NEAR(ism::densityConfidence(2000, p), 0.11920292202211755, 1e-12);	 // 1/(1+e^2)
+	EXPECT_GT(ism::densityConfidence(1e6, p), 0.999999);
+}
+
+TEST(IsmFormulas, ObstacleProbability)
+{
+	const IsmParams p;	// K_m = 0.8
+	EXPECT_NEAR(ism::obstacleProbability(0.0, p), 0.5, 1e-12);
+	EXPECT_NEAR(ism::obstacleProbability(0.5, p), 0.7, 1e-12);
+	EXPECT_NEAR(ism::obstacleProbability(1.0, p), 0.9, 1e-12);
+	EXPECT_NEAR(ism::obstacleProbability(0.8807970779778823, p), 0.5 + 0.4 * 0.8807970779778823, 1e-12);
+}
+
+TEST(IsmFormulas, GroundProbability)
+{
+	const IsmParams p;	// K_g = 0.3, sigma2 = 0.02
+	EXPECT_NEAR(ism::groundProbability(0.0, p), 0.2, 1e-12);
+	// d = 0.1: exp(-0.01 / 0.04) = exp(-0.25) = 0.7788007830714049
+	EXPECT_NEAR(ism::groundProbability(0.1, p), 0.5 - 0.3 * 0.7788007830714049, 1e-12);
+	EXPECT_NEAR(ism::groundProbability(-0.1, p), 0.26635976507857853, 1e-12);
+	// d = 0.2: exp(-1)
+	EXPECT_NEAR(ism::groundProbability(0.2, p), 0.38963616764856766, 1e-12);
+	// d = d_pth = 0.03: exp(-0.0009 / 0.04) = exp(-0.0225) = 0.9777512371933363
+	EXPECT_NEAR(ism::groundProbability(0.03, p), 0.5 - 0.3 * 0.9777512371933363, 1e-12);
+	EXPECT_NEAR(ism::groundProbability(10.0, p), 0.5, 1e-12);
+}
+
+TEST(IsmFormulas, Combine)
+{
+	EXPECT_FLOAT_EQ(ism::combine(0.7f, 0.2f), 0.7f);  // occupied wins
+	EXPECT_FLOAT_EQ(ism::combine(0.2f, 0.6f), 0.6f);
+	EXPECT_FLOAT_EQ(ism::combine(0.6f, 0.9f), 0.9f);  // the largest occupied
+	EXPECT_FLOAT_EQ(ism::combine(0.9f, 0.6f), 0.9f);
+	EXPECT_FLOAT_EQ(ism::combine(0.3f, 0.2f), 0.2f);  // the strongest free
+	EXPECT_FLOAT_EQ(ism::combine(0.5f, 0.3f), 0.3f);
+	EXPECT_FLOAT_EQ(ism::combine(0.3f, 0.5f), 0.3f);
+	EXPECT_FLOAT_EQ(ism::combine(0.5f, 0.5f), 0.5f);
+	EXPECT_FLOAT_EQ(ism::combine(0.5f, 0.51f), 0.51f);
+}
+
+TEST(IsmParamsTest, ValidateAndDefaults)
+{
+	const IsmParams d;
+	EXPECT_DOUBLE_EQ(d.K_g, 0.3);
+	EXPECT_DOUBLE_EQ(d.sigma2, 0.02);
+	EXPECT_DOUBLE_EQ(d.K_m, 0.8);
+	EXPECT_DOUBLE_EQ(d.d_pth, 0.03);
+	EXPECT_NO_THROW(d.validate());
+	auto bad = [](auto mutate) {
+		IsmParams p;
+		mutate(p);
+		return p;
+	};
+	EXPECT_THROW(bad([](IsmParams& p) { p.d_pth = 0; }).validate(), std::invalid_argument);
+	EXPECT_THROW(bad([](IsmParams& p) { p.K_g = 0.5; }).validate(), std::invalid_argument);
+	EXPECT_THROW(bad([](IsmParams& p) { p.K_g = -0.1; }).validate(), std::invalid_argument);
+	EXPECT_THROW(bad([](IsmParams& p) { p.sigma2 = 0; }).validate(), std::invalid_argument);
+	EXPECT_THROW(bad([](IsmParams& p) { p.K_n = 0; }).validate(), std::invalid_argument);
+	EXPECT_THROW(bad([](IsmParams& p) { p.d_min = NAN; }).validate(), std::invalid_argument);
+	EXPECT_THROW(bad([](IsmParams& p) { p.K_m = 1.0; }).validate(), std::invalid_argument);
+	EXPECT_THROW(bad([](IsmParams& p) { p.noise_sigmas = -1; }).validate(), std::invalid_argument);
+	EXPECT_THROW(bad([](IsmParams& p) { p.robot_height = 0; }).validate(), std::invalid_argument);
+	EXPECT_THROW(bad([](IsmParams& p) { p.max_range = 0; }).validate(), std::invalid_argument);
+	EXPECT_THROW(bad([](IsmParams& p) { p.max_drop_ray_length = -1; }).validate(), std::invalid_argument);
+
+	// compute() validates too.
+	InverseSensorModel ism(bad([](IsmParams& p) { p.K_m = 2; }));
+	ElevationGrid grid;
+	IsmStats st;
+	EXPECT_THROW(ism.compute(grid, handDetection(kFloor), {0, 0, 1}, st), std::invalid_argument);
+}
+
+TEST(InverseSensorModel, GroundBandNoiseModel)
+{
+	InverseSensorModel ism;	 // d_pth 0.03, c0 0.0012, c2 0.0019, 3 sigmas
+	// Sensor 1 m above the floor, voxel on the floor 3 m ahead: r^2 = 10.
+	const double r = std::sqrt(10.0);
+	EXPECT_NEAR(
+		ism.groundBand({0, 0, 1}, 1.0, 3, 0, 0), 0.03 + 3 * (0.0012 + 0.0019 * 10) * (1 / r), 1e-12);
+	// 0.049163...
+	EXPECT_NEAR(ism.groundBand({0, 0, 1}, 1.0, 3, 0, 0), 0.0491627, 1e-6);
+	// The sign of the sensor height does not matter.
+	EXPECT_NEAR(ism.groundBand({0, 0, 1}, -1.0, 3, 0, 0), ism.groundBand({0, 0, 1}, 1.0, 3, 0, 0), 1e-15);
+	// Straight below the sensor, h / r clamped to 1: 0.03 + 3 * (0.0012 + 0.0019).
+	EXPECT_NEAR(ism.groundBand({0, 0, 1}, 5.0, 0, 0, 0), 0.03 + 3 * 0.0031, 1e-12);
+	// At the sensor: just d_pth.
+	EXPECT_NEAR(ism.groundBand({1, 2, 3}, 1.0, 1, 2, 3), 0.03, 1e-15);
+	// Far floor gets a wider band than near floor.
+	EXPECT_GT(ism.groundBand({0, 0, 1}, 1.0, 4.5, 0, 0), ism.groundBand({0, 0, 1}, 1.0, 1.5, 0, 0));
+
+	IsmParams p;
+	p.noise_sigmas = 0;	 // the paper's fixed band
+	ism.setParams(p);
+	EXPECT_DOUBLE_EQ(ism.groundBand({0, 0, 1}, 1.0, 3, 0, 0), 0.03);
+	p.noise_sigmas = 2;
+	p.depth_noise_c0 = 0.01;
+	p.depth_noise_c2 = 0.0;
+	p.d_pth = 0.05;
+	ism.setParams(p);
+	// r = 4 (same height), h = 1: 0.05 + 2 * 0.01 * 1/4
+	EXPECT_NEAR(ism.groundBand({0, 0, 1}, 1.0, 4, 0, 1), 0.055, 1e-12);
+}
+
+TEST(InverseSensorModel, ClassifyAgainstAPlane)
+{
+	InverseSensorModel ism;	 // robot_height 1.8
+	const double band = 0.05;
+	double d = 99;
+	EXPECT_EQ(ism.classify(cellOf({-0.01f, 0.02f}), 1, 1, kFloor, band, d), VoxelClass::Ground);
+	EXPECT_NEAR(d, 0.005, 1e-6);  // the mean's distance
+	EXPECT_EQ(ism.classify(cellOf({0.049f}), 1, 1, kFloor, band, d), VoxelClass::Ground);  // inside the band
+	EXPECT_EQ(ism.classify(cellOf({-0.049f}), 1, 1, kFloor, band, d), VoxelClass::Ground);
+	EXPECT_EQ(ism.classify(cellOf({0.0f, 0.3f}), 1, 1, kFloor, band, d), VoxelClass::Obstacle);
+	EXPECT_NEAR(d, 0.15, 1e-6);
+	EXPECT_EQ(ism.classify(cellOf({0.06f}), 1, 1, kFloor, band, d), VoxelClass::Obstacle);
+	EXPECT_EQ(ism.classify(cellOf({-0.4f, -0.3f}), 1, 1, kFloor, band, d), VoxelClass::Drop);
+	EXPECT_EQ(ism.classify(cellOf({-0.06f}), 1, 1, kFloor, band, d), VoxelClass::Drop);
+	// Top on the floor, bottom 20 cm below: edge of a hole.
+	EXPECT_EQ(ism.classify(cellOf({-0.2f, 0.01f}), 1, 1, kFloor, band, d), VoxelClass::Drop);
+	// Entirely above the robot: ignored; reaching down below robot_height: obstacle.
+	EXPECT_EQ(ism.classify(cellOf({1.9f, 2.2f}), 1, 1, kFloor, band, d), VoxelClass::Overhead);
+	EXPECT_EQ(ism.classify(cellOf({1.0f, 2.0f}), 1, 1, kFloor, band, d), VoxelClass::Obstacle);
+	// A wall through the plane (from below it to above it) is an obstacle.
+	EXPECT_EQ(ism.classify(cellOf({-0.3f, 1.0f}), 1, 1, kFloor, band, d), VoxelClass::Obstacle);
+	// The band matters.
+	EXPECT_EQ(ism.classify(cellOf({0.04f}), 1, 1, kFloor, 0.03, d), VoxelClass::Obstacle);
+	EXPECT_EQ(ism.classify(cellOf({0.04f}), 1, 1, kFloor, 0.045, d), VoxelClass::Ground);
+
+	// A 10 deg plane z = tan(10 deg) x: distances are perpendicular.
+	const double s = std::sin(deg2rad(10)), c = std::cos(deg2rad(10));
+	const Plane tilted{-s, 0, c, 0};
+	const float zp = float(std::tan(deg2rad(10)) * 1.0);  // 0.1763 at x = 1
+	EXPECT_EQ(ism.classify(cellOf({zp - 0.01f, zp + 0.01f}), 1, 0, tilted, band, d), VoxelClass::Ground);
+	EXPECT_NEAR(d, -s * 1.0 + c * zp, 1e-6);
+	EXPECT_EQ(ism.classify(cellOf({zp + 0.1f}), 1, 0, tilted, band, d), VoxelClass::Obstacle);
+	EXPECT_NEAR(d, c * 0.1, 1e-6);
+	// Flat-floor height 0 at x = 1 is 17 cm below that plane.
+	EXPECT_EQ(ism.classify(cellOf({0.0f}), 1, 0, tilted, band, d), VoxelClass::Drop);
+
+	IsmParams p;
+	p.robot_height = 0.5;
+	ism.setParams(p);
+	EXPECT_EQ(ism.classify(cellOf({1.0f, 1.2f}), 1, 1, kFloor, band, d), VoxelClass::Overhead);
+}
+
+namespace
+{
+// Frame of test ISM-1 (grid -5..5 m, 5 cm). Sensor at (0, 0, 1), ground z = 0.
+bool isBox(double x, double y) { return inRect(x, y, 1.2, 1.3, 0.5, 0.6); }	 // 2x2 cells
+bool isHole(double x, double y) { return inRect(x, y, 1.5, 1.6, -0.5, -0.4); }	 // 2x2 cells
+bool isFloor(double x, double y) { return inRect(x, y, 0.5, 2.0, -1.0, 1.0) && !isBox(x, y) && !isHole(x, y); }
+bool isBeam(double x, double y) { return inRect(x, y, 0.7, 0.8, 1.2, 1.3); }
+bool isShelf(double x, double y) { return inRect(x, y, 0.7, 0.8, -1.3, -1.2); }
+bool isFar(double x, double y) { return inRect(x, y, 4.2, 4.3, 0.0, 0.1); }
+
+ElevationGrid sceneFrame()
+{
+	ElevationGrid grid;
+	std::mt19937 rng(1);
+	BinnedPoints b;
+	auto zero = [](double, double) { return 0.0; };
+	gamtest::sampleSurfaceIf(grid, isFloor, zero, 2, 0.0, rng, b);	// 4 pts at z = 0
+	gamtest::sampleColumns(grid, 1.2, 1.3, 0.5, 0.6, 0.0, 0.4, 0.1, b);	// 5 pts, span 0.4
+	gamtest::sampleSurfaceIf(grid, isHole, [](double, double) { return -0.3; }, 1, 0.0, rng, b);
+	gamtest::sampleColumns(grid, 0.7, 0.8, 1.2, 1.3, 1.9, 2.3, 0.1, b);	 // above 1.8
+	gamtest::sampleColumns(grid, 0.7, 0.8, -1.3, -1.2, 1.0, 2.5, 0.1, b);  // 16 pts, span 1.5
+	gamtest::sampleColumns(grid, 4.2, 4.3, 0.0, 0.1, 0.0, 0.4, 0.1, b);
+	gamtest::insertAll(grid, b);
+	return grid;
+}
+}  // namespace
+
+TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
+{
+	const ElevationGrid frame = sceneFrame();
+	const GridGeometry& g = frame.geometry();
+	IsmParams p;
+	p.max_range = 4.0;
+	InverseSensorModel ism(p);
+	IsmStats st;
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	EXPECT_TRUE(st.applied);
+
+	const double pBox = handObstacleP(5, 0.4, 0.05);	 // rho 5000: 0.651016
+	const double pHole = handObstacleP(1, 0.0, 0.05);	 // rho 8000: 0.792423
+	const double pShelf = handObstacleP(16, 1.5, 0.05);
+	EXPECT_NEAR(pBox, 0.5 + 0.4 / (1 + std::exp(0.5)), 1e-12);
+	EXPECT_NEAR(pHole, 0.5 + 0.4 / (1 + std::exp(-1.0)), 1e-12);
+
+	size_t nFloor = 0, nBox = 0, nHole = 0, nBeam = 0, nShelf = 0, nFar = 0;
+	for (int cy = 0; cy < g.ny; cy++)
+		for (int cx = 0; cx < g.nx; cx++)
+		{
+			const double x = g.cx(cx), y = g.cy(cy);
+			const size_t i = g.index(cx, cy);
+			const float e = ism.evidence()[i];
+			const VoxelClass k = ism.classes()[i];
+			if (isFloor(x, y))
+			{
+				nFloor++;
+				EXPECT_EQ(k, VoxelClass::Ground) << x << "," << y;
+				EXPECT_FLOAT_EQ(e, 0.2f) << x << "," << y;	// 0.5 - K_g: on the plane
+			}
+			else if (isBox(x, y))
+			{
+				nBox++;
+				EXPECT_EQ(k, VoxelClass::Obstacle);
+				EXPECT_NEAR(e, pBox, 1e-6);
+				EXPECT_GT(e, 0.5f);
+			}
+			else if (isHole(x, y))
+			{
+				nHole++;
+				EXPECT_EQ(k, VoxelClass::Drop);
+				EXPECT_NEAR(e, pHole, 1e-6);
+				EXPECT_GT(e, 0.5f);
+			}
+			else if (isBeam(x, y))
+			{
+				nBeam++;
+				EXPECT_EQ(k, VoxelClass::Overhead);
+				EXPECT_EQ(e, 0.5f);
+			}
+			else if (isShelf(x, y))
+			{
+				nShelf++;
+				EXPECT_EQ(k, VoxelClass::Obstacle);
+				EXPECT_NEAR(e, pShelf, 1e-6);
+			}
+			else if (isFar(x, y))
+			{
+				nFar++;
+				EXPECT_EQ(k, VoxelClass::OutOfRange);  // 4.2 m > max_range 4
+				EXPECT_EQ(e, 0.5f);
+			}
+			else
+			{
+				ASSERT_EQ(k, VoxelClass::None) << x << "," << y;
+				ASSERT_EQ(e, 0.5f) << x << "," << y;
+			}
+		}
+	ASSERT_EQ(nFloor, 30u * 40u - 8u);
+	ASSERT_EQ(nBox, 4u);
+	ASSERT_EQ(nHole, 4u);
+	ASSERT_EQ(nBeam, 4u);
+	ASSERT_EQ(nShelf, 4u);
+	ASSERT_EQ(nFar, 4u);
+	EXPECT_EQ(st.ground, nFloor);
+	EXPECT_EQ(st.obstacle, nBox + nShelf);
+	EXPECT_EQ(st.drop, nHole);
+	EXPECT_EQ(st.overhead, nBeam);
+	EXPECT_EQ(st.out_of_range, nFar);
+	// The hole's rays crossed the plane over observed floor: nothing to mark.
+	EXPECT_EQ(st.drop_ray_cells, 0u);
+	EXPECT_EQ(ism.evidenceCells().size(), nFloor + nBox + nHole + nShelf);
+	checkEvidenceBookkeeping(ism);
+
+	// With the default max_range (5 m) the far box counts.
+	ism.setParams(IsmParams{});
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	EXPECT_EQ(st.out_of_range, 0u);
+	EXPECT_EQ(st.obstacle, nBox + nShelf + nFar);
+	EXPECT_GT(ism.evidence()[g.index(g.ix(4.25), g.iy(0.05))], 0.5f);
+	checkEvidenceBookkeeping(ism);
+}
+
+TEST(InverseSensorModel, GroundEvidenceFollowsPlaneDistance)
+{
+	// The same floor against a plane 1 cm above it: d = -0.01 for every cell.
+	const ElevationGrid frame = sceneFrame();
+	InverseSensorModel ism;
+	IsmStats st;
+	ism.compute(frame, handDetection(Plane{0, 0, 1, -0.01}), {0, 0, 1}, st);
+	const GridGeometry& g = frame.geometry();
+	const size_t i = g.index(g.ix(1.0), g.iy(0.0));
+	EXPECT_EQ(ism.classes()[i], VoxelClass::Ground);
+	EXPECT_NEAR(ism.evidence()[i], 0.5 - 0.3 * std::exp(-0.0001 / 0.04), 1e-6);	 // 0.200749
+}
+
+TEST(InverseSensorModel, NoPlaneNeverInventsObstacles)
+{
+	const ElevationGrid frame = sceneFrame();
+	InverseSensorModel ism;
+	IsmStats st;
+	// First a normal frame, so that there is evidence to forget.
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	ASSERT_FALSE(ism.evidenceCells().empty());
+
+	for (auto s : {GroundDetection::Status::EmptyGrid, GroundDetection::Status::NoValidSeed,
+				   GroundDetection::Status::TooFewNodes, GroundDetection::Status::NoConsensus})
+	{
+		// Even with a plane in the result, a failed detection produces nothing.
+		ism.compute(frame, handDetection(kFloor, s), {0, 0, 1}, st);
+		EXPECT_FALSE(st.applied);
+		EXPECT_TRUE(ism.evidenceCells().empty()) << GroundDetection::statusName(s);
+		EXPECT_EQ(st.obstacle + st.ground + st.drop + st.overhead + st.out_of_range, 0u);
+		for (float e : ism.evidence()) ASSERT_EQ(e, 0.5f);
+		for (VoxelClass k : ism.classes()) ASSERT_EQ(k, VoxelClass::None);
+	}
+	// Status Ok but no plane: nothing either.
+	GroundDetection none;
+	none.status = GroundDetection::Status::Ok;
+	ism.compute(frame, none, {0, 0, 1}, st);
+	EXPECT_FALSE(st.applied);
+	EXPECT_TRUE(ism.evidenceCells().empty());
+
+	// A real detection failure on a real grid: no floor near z = 0.
+	ElevationGrid table;
+	std::mt19937 rng(4);
+	BinnedPoints b;
+	gamtest::sampleSurface(table, -1, 1, -1, 1, [](double, double) { return 0.9; }, 2, 0.002, rng, b);
+	gamtest::insertAll(table, b);
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(table, {0, 0, 0}, out);
+	ASSERT_EQ(out.status, GroundDetection::Status::NoValidSeed);
+	ism.compute(table, out, {0, 0, 1}, st);
+	EXPECT_TRUE(ism.evidenceCells().empty());
+}
+
+namespace
+{
+// Downward step: upper floor z = 0 on x in [0.5, 1.5), unseen gap, lower floor
+// z = -0.3 on x in [2.6, 3.5) (1 point per cell), y in [-0.5, 0.5); an
+// observed floor patch inside the gap at x in [2.2, 2.3), y in [-0.1, 0.1).
+bool isUpper(double x, double y) { return inRect(x, y, 0.5, 1.5, -0.5, 0.5); }
+bool isLower(double x, double y) { return inRect(x, y, 2.6, 3.5, -0.5, 0.5); }
+bool isPatch(double x, double y) { return inRect(x, y, 2.2, 2.3, -0.1, 0.1); }
+ElevationGrid stepFrame()
+{
+	ElevationGrid grid;
+	std::mt19937 rng(1);
+	BinnedPoints b;
+	gamtest::sampleSurfaceIf(grid, isUpper, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
+	gamtest::sampleSurfaceIf(grid, isPatch, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
+	gamtest::sampleSurfaceIf(grid, isLower, [](double, double) { return -0.3; }, 1, 0.0, rng, b);
+	gamtest::insertAll(grid, b);
+	return grid;
+}
+}  // namespace
+
+TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
+{
+	const ElevationGrid frame = stepFrame();
+	const GridGeometry& g = frame.geometry();
+	InverseSensorModel ism;
+	IsmStats st;
+	// Sensor 1 m above the plane at the origin: the ray to a voxel at (x, y,
+	// -0.3) crosses z = 0 at 1/1.3 of the way, e.g. x = 2.625 -> 2.019 and
+	// x = 3.475 -> 2.673.
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	const double pDrop = handObstacleP(1, 0.0, 0.05);
+	EXPECT_EQ(st.drop, 18u * 20u);
+	EXPECT_GT(st.drop_ray_cells, 0u);
+
+	for (int cy = g.iy(-0.1); cy <= g.iy(0.1); cy++)
+		for (int cx = g.ix(1.5); cx < g.ix(2.6); cx++)
+		{
+			const double x = g.cx(cx), y = g.cy(cy);
+			const float e = ism.evidence()[g.index(cx, cy)];
+			if (isPatch(x, y))
+			{
+				// Observed ground keeps its free evidence under the rays.
+				EXPECT_EQ(ism.classes()[g.index(cx, cy)], VoxelClass::Ground);
+				EXPECT_FLOAT_EQ(e, 0.2f) << x << "," << y;
+			}
+			else if (x < 2.0)
+			{
+				EXPECT_EQ(e, 0.5f) << "before every crossing: " << x << "," << y;
+			}
+			else if (x > 2.1)
+			{
+				EXPECT_NEAR(e, pDrop, 1e-6) << "under the rays: " << x << "," << y;
+			}
+		}
+	// The upper floor is untouched.
+	for (int cy = g.iy(-0.45); cy <= g.iy(0.45); cy++)
+		for (int cx = g.ix(0.55); cx <= g.ix(1.45); cx++)
+			EXPECT_FLOAT_EQ(ism.evidence()[g.index(cx, cy)], 0.2f);
+	// Nothing is marked where no ray went: beside the lower floor, or behind it.
+	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.3), g.iy(1.0))], 0.5f);
+	EXPECT_EQ(ism.evidence()[g.index(g.ix(3.6), g.iy(0.0))], 0.5f);
+	checkEvidenceBookkeeping(ism);
+
+	// Limited ray length: only the 0.2 m before each voxel.
+	IsmParams p;
+	p.max_drop_ray_length = 0.2;
+	ism.setParams(p);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.15), g.iy(0.2))], 0.5f);
+	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.35), g.iy(0.2))], 0.5f);
+	EXPECT_NEAR(ism.evidence()[g.index(g.ix(2.55), g.iy(0.2))], pDrop, 1e-6);
+
+	// Disabled: the gap stays unknown, the drop voxels still count.
+	p.drop_rays = false;
+	ism.setParams(p);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	EXPECT_EQ(st.drop_ray_cells, 0u);
+	EXPECT_EQ(st.drop, 18u * 20u);
+	for (int cx = g.ix(1.5); cx < g.ix(2.6); cx++)
+	{
+		if (!isPatch(g.cx(cx), 0.025)) { EXPECT_EQ(ism.evidence()[g.index(cx, g.iy(0.025))], 0.5f); }
+	}
+	EXPECT_NEAR(ism.evidence()[g.index(g.ix(3.0), g.iy(0.0))], pDrop, 1e-6);
+}
+
+TEST(InverseSensorModel, RampIsGroundOnlyWithLocalPlanes)
+{
+	ElevationGrid grid;
+	std::mt19937 rng(21);
+	gamtest::buildRamp(grid, rng);
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(grid, {0, 0, 0}, out);
+	ASSERT_EQ(out.status, GroundDetection::Status::Ok) << out.describe();
+	ASSERT_GE(out.planes.size(), 2u);
+	const GridGeometry& g = grid.geometry();
+	const Eigen::Vector3d sensor(0, 0, 1);
+
+	auto fractions = [&](bool local, double& ground, double& obstacle, double& floorGround) {
+		IsmParams p;
+		p.local_planes = local;
+		InverseSensorModel ism(p);
+		IsmStats st;
+		ism.compute(grid, out, sensor, st);
+		size_t n = 0, ng = 0, no = 0, nf = 0, nfg = 0;
+		for (uint32_t idx : grid.observedCells())
+		{
+			const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
+			const double x = g.cx(cx), y = g.cy(cy);
+			if (x >= 2.0 && x < 2.9 && std::abs(y) < 2.0)
+			{
+				// Ramp 10.5..20 cm above the floor plane.
+				n++;
+				ng += ism.classes()[idx] == VoxelClass::Ground;
+				no += ism.classes()[idx] == VoxelClass::Obstacle;
+				if (ism.classes()[idx] == VoxelClass::Ground) { EXPECT_LT(ism.evidence()[idx], 0.5f); }
+				if (ism.classes()[idx] == VoxelClass::Obstacle) { EXPECT_GT(ism.evidence()[idx], 0.5f); }
+			}
+			else if (x < 0.8 && x > -2.0 && std::abs(y) < 2.0)
+			{
+				nf++;
+				nfg += ism.classes()[idx] == VoxelClass::Ground;
+			}
+		}
+		ASSERT_GT(n, 500u);
+		ground = double(ng) / n;
+		obstacle = double(no) / n;
+		floorGround = double(nfg) / nf;
+	};
+	double g1, o1, f1, g0, o0, f0;
+	fractions(true, g1, o1, f1);
+	fractions(false, g0, o0, f0);
+	std::cout << "ISM ramp cells: local planes -> " << 100 * g1 << "% ground, " << 100 * o1
+			  << "% obstacle; single plane -> " << 100 * g0 << "% ground, " << 100 * o0
+			  << "% obstacle" << std::endl;
+	EXPECT_GT(g1, 0.95);
+	EXPECT_LT(o1, 0.05);
+	EXPECT_GT(o0, 0.95);
+	EXPECT_LT(g0, 0.05);
+	// The flat floor is ground either way.
+	EXPECT_GT(f1, 0.99);
+	EXPECT_GT(f0, 0.99);
+}
