@@ -77,7 +77,7 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 			m_filterLimit[c] = std::numeric_limits<float>::infinity();
 			if (fc.count < filter.min_count) continue;
 			const float m = fc.mean();
-			const float lim = filter.sigmas * std::sqrt(fc.variance());
+			const float lim = std::max(filter.min_band, filter.sigmas * std::sqrt(fc.variance()));
 			if (m - lim <= fc.z_min && m + lim >= fc.z_max) continue;
 			anyFiltered = true;
 			m_filterMean[c] = m;

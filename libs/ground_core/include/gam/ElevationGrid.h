@@ -109,6 +109,10 @@ struct OutlierFilterParams
 	/** Cells with fewer samples keep all of them: with n points no sample can be
 	 * more than (n-1)/sqrt(n) std away, so the rule is void for n <= 10 anyway. */
 	uint32_t min_count = 4;
+	/** The band never gets narrower than +-this [m]: on a flat surface the
+	 * std is ~0 (and float round-off can make it exactly 0), which would
+	 * otherwise reject good samples. 5 mm is below any depth camera's noise. */
+	float min_band = 0.005f;
 };
 
 /** Inverse distance weighting densification (fills empty cells). */
