@@ -242,6 +242,63 @@ TEST(ElevationGridFilter, TighterSigmasRemoveMore)
 	EXPECT_EQ(g3.cell(0, 0).count, 10u);
 }
 
+TEST(ElevationGridFilter, KeepsInliersFarFromZeroHeight)
+{
+	// A floor at z = +-10 m (an upper storey in the map frame) with 3 mm noise
+	// plus one sample 0.5 m above: only that sample may go. (The one-pass
+	// variance of the float sums used to come out ~0 here and the filter threw
+	// away good samples.)
+	for (float base : {10.0f, -10.0f, 30.0f})
+	{
+		std::mt19937 rng(1);
+		std::normal_distribution<float> N(0.f, 0.003f);
+		std::vector<float> clean;
+		for (int i = 0; i < 40; i++) clean.push_back(base + N(rng));
+		double s = 0, s2 = 0;
+		for (float z : clean) s += z;
+		s += base + 0.5f;
+		const double m = s / 41;
+		for (float z : clean) s2 += (z - m) * (z - m);
+		s2 += (base + 0.5 - m) * (base + 0.5 - m);
+		const double sd = std::sqrt(s2 / 41);
+		for (float z : clean) ASSERT_LE(std::abs(z - m), 3 * sd);  // premise
+		ASSERT_GT(std::abs(base + 0.5 - m), 3 * sd);
+
+		ElevationGrid grid(makeGeometry(0, 0, 1.0, 2, 2));
+		BinnedPoints b;
+		for (float z : clean) grid.binPoint(0.5, 0.5, z, b);
+		grid.binPoint(0.5, 0.5, base + 0.5f, b);
+		EXPECT_EQ(grid.insert(b, OutlierFilterParams{}), 40u) << base;
+		EXPECT_EQ(grid.cell(0, 0).count, 40u) << base;
+		EXPECT_FLOAT_EQ(grid.cell(0, 0).z_max, *std::max_element(clean.begin(), clean.end()));
+		EXPECT_FLOAT_EQ(grid.cell(0, 0).z_min, *std::min_element(clean.begin(), clean.end()));
+
+		// Without the outlier nothing at all is removed.
+		ElevationGrid g2(makeGeometry(0, 0, 1.0, 2, 2));
+		b.clear();
+		for (float z : clean) g2.binPoint(0.5, 0.5, z, b);
+		EXPECT_EQ(g2.insert(b, OutlierFilterParams{}), 40u) << base;
+	}
+}
+
+TEST(ElevationGridFilter, MinimumBand)
+{
+	// {0 x8, 0.004 x2}: mean 0.0008, std 0.0016. A 1-sigma band (+-1.6 mm)
+	// would drop the two 4 mm samples; the 5 mm minimum band keeps them.
+	ElevationGrid grid(makeGeometry(0, 0, 1.0, 2, 2));
+	BinnedPoints b;
+	for (int i = 0; i < 8; i++) grid.binPoint(0.5, 0.5, 0.f, b);
+	for (int i = 0; i < 2; i++) grid.binPoint(0.5, 0.5, 0.004f, b);
+	OutlierFilterParams f;
+	f.sigmas = 1.0f;
+	EXPECT_EQ(grid.insert(b, f), 10u);
+	EXPECT_EQ(grid.cell(0, 0).count, 10u);
+	f.min_band = 0.f;
+	ElevationGrid g2(makeGeometry(0, 0, 1.0, 2, 2));
+	EXPECT_EQ(g2.insert(b, f), 8u);
+	EXPECT_FLOAT_EQ(g2.cell(0, 0).z_max, 0.f);
+}
+
 namespace
 {
 // 10x10 cells of 1 m; observed: (4,5) z=1, (6,5) z=2, (6,6) z=3.
