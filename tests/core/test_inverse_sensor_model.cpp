@@ -484,6 +484,31 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	EXPECT_NEAR(ism.evidence()[g.index(g.ix(3.0), g.iy(0.0))], pDrop, 1e-6);
 }
 
+TEST(InverseSensorModel, NeutralEvidenceIsNeverListed)
+{
+	// K_g = 0 and K_m = 0 (both valid) make every voxel say exactly 0.5:
+	// evidenceCells() ("cells with evidence != 0.5") must stay empty, and the
+	// drop rays must not list their cells once per ray.
+	const ElevationGrid frame = stepFrame();
+	IsmParams p;
+	p.K_g = 0;
+	p.K_m = 0;
+	InverseSensorModel ism(p);
+	IsmStats st;
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	EXPECT_GT(st.ground, 0u);
+	EXPECT_GT(st.drop, 0u);
+	EXPECT_TRUE(ism.evidenceCells().empty()) << ism.evidenceCells().size() << " cells listed";
+	checkEvidenceBookkeeping(ism);
+
+	// Only K_m = 0: the floor is listed (free), the drops and rays are not.
+	p.K_g = 0.3;
+	ism.setParams(p);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	EXPECT_EQ(ism.evidenceCells().size(), st.ground);
+	checkEvidenceBookkeeping(ism);
+}
+
 TEST(InverseSensorModel, RampIsGroundOnlyWithLocalPlanes)
 {
 	ElevationGrid grid;

@@ -85,8 +85,12 @@ VoxelClass InverseSensorModel::classify(
 void InverseSensorModel::put(uint32_t cell, float p)
 {
 	float& e = m_evidence[cell];
-	if (e == 0.5f) m_evidenceCells.push_back(cell);
+	const bool wasNeutral = e == 0.5f;
 	e = ism::combine(e, p);
+	// List a cell once, when it first leaves 0.5 (combine never brings it back).
+	// Evidence of exactly 0.5 (K_g = 0 or K_m = 0) is no evidence: listing it
+	// put neutral cells, and duplicates, into evidenceCells().
+	if (wasNeutral && e != 0.5f) m_evidenceCells.push_back(cell);
 }
 
 void InverseSensorModel::buildSupport(const GridGeometry& g, const GroundDetection& det)
