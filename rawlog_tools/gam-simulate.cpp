@@ -3,7 +3,7 @@
 // writes the ground-truth grid. See config/scenes/README.md.
 //
 // usage: gam-simulate --scene FILE.scene --out PREFIX [--seed N] [--no-noise]
-//                     [--frames N] [--no-leddar]
+//                     [--frames N] [--no-leddar] [--depth-images]
 // outputs: PREFIX.rawlog, PREFIX_gt.pgm, PREFIX_gt.yaml, PREFIX_gt_objects.csv,
 //          PREFIX_gt_labels.csv, PREFIX_gt_path.csv
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -116,6 +116,8 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<int> argFrames("", "frames", "keep only the first N frames", false, 0, "N", cmd);
 		TCLAP::SwitchArg argNoNoise("", "no-noise", "exact sensors and odometry", cmd);
 		TCLAP::SwitchArg argNoLeddar("", "no-leddar", "do not simulate the Leddar", cmd);
+		TCLAP::SwitchArg argDepthPgm(
+			"", "depth-images", "also write PREFIX_depth_NNNN.pgm (16-bit, millimetres) per frame", cmd);
 		cmd.parse(argc, argv);
 
 		const auto t0 = std::chrono::steady_clock::now();
@@ -198,6 +200,20 @@ int main(int argc, char** argv)
 					validPix += u > 0;
 				}
 			ar << *k;
+			if (argDepthPgm.getValue())
+			{
+				char name[32];
+				std::snprintf(name, sizeof(name), "_depth_%04zu.pgm", i);
+				std::ofstream f(prefix + name, std::ios::binary);
+				f << "P5\n" << fr.width << " " << fr.height << "\n65535\n";
+				for (int r = 0; r < fr.height; r++)
+					for (int c = 0; c < fr.width; c++)
+					{
+						const uint16_t v = k->rangeImage(r, c);
+						f.put(char(v >> 8));
+						f.put(char(v & 0xff));
+					}
+			}
 
 			if (leddarOn)
 			{

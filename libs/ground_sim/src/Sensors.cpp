@@ -63,13 +63,19 @@ DepthFrame KinectModel::render(const Scene& scene, const Pose3& sensor, std::mt1
 				f.incidence[i] = float(std::acos(cosi));
 				f.object_id[i] = h.object_id;
 				if (h.t >= p.min_range && h.t <= p.max_range)
-					f.footprint.emplace_back(h.point.x(), h.point.y());
+				{
+					// 5 mm into the surface, so that a face lying on a cell
+					// border marks the cell of the object, not the one in front
+					const Eigen::Vector3d q = h.point - 0.005 * h.normal;
+					f.footprint.emplace_back(q.x(), q.y());
+				}
 			}
-			if ((!h.hit || h.t > p.max_range) && dir.z() < 0)
+			if (dir.z() < 0 && sensor.t.z() > 0)
 			{
-				// rays lost in a pit: where they crossed the floor level
+				// rays entering a pit (hitting its walls or bottom, or lost in
+				// it): the opening they crossed at the floor level was seen too
 				const double t0 = -sensor.t.z() / dir.z();
-				if (t0 >= p.min_range && t0 <= p.max_range)
+				if ((!h.hit || h.t > t0 + 1e-6) && t0 >= p.min_range && t0 <= p.max_range)
 				{
 					const Eigen::Vector3d q = sensor.t + t0 * dir;
 					f.footprint.emplace_back(q.x(), q.y());

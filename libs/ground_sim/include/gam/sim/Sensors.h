@@ -94,8 +94,9 @@ struct DepthFrame
 	std::vector<int> object_id;	 ///< id of the surface hit (0 floor / none)
 	std::vector<uint8_t> flags;
 	/** Geometric visible footprint (noise-free): world xy of every true hit
-	 * within the valid range, plus the z=0 crossing of rays that fall into a
-	 * pit without meeting a surface in range. */
+	 * within the valid range (5 mm inside the surface hit), plus the z=0
+	 * crossing of rays that go into a pit (hitting its walls or bottom, or
+	 * nothing) when that crossing is within the valid range. */
 	std::vector<Eigen::Vector2d> footprint;
 	size_t idx(int r, int c) const { return size_t(r) * size_t(width) + size_t(c); }
 };
