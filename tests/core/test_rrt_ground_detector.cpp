@@ -399,3 +399,80 @@ TEST(RrtGroundDetector, RampBecomesAnExtraPlane)
 	det.detect(grid, {0, 0, 0}, out);
 	EXPECT_EQ(out.planes.size(), 1u);
 }
+
+TEST(RrtGroundDetector, NarrowCorridorKeepsItsRoll)
+{
+	// A 30 cm wide, 6 m long corridor rolled 3 deg about X: the nodes lie
+	// almost on a line, so RANSAC alone cannot fix the roll; the plane must
+	// still come out 3 deg, leaning towards -Y.
+	ElevationGrid grid;
+	std::mt19937 rng(1);
+	gam::BinnedPoints b;
+	const double s = std::tan(deg2rad(3.0));
+	gamtest::sampleSurfaceIf(
+		grid, [](double x, double y) { return gamtest::inRect(x, y, -3, 3, -0.15, 0.15); },
+		[s](double, double y) { return s * y; }, 3, 0.002, rng, b);
+	gamtest::insertAll(grid, b);
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(grid, {0, 0, 0}, out);
+	ASSERT_EQ(out.status, Status::Ok) << out.describe();
+	EXPECT_NEAR(rad2deg(out.plane().tiltAngle()), 3.0, 0.3);
+	EXPECT_LT(out.plane().b, -0.045);
+	EXPECT_NEAR(out.plane().a, 0.0, 0.005);
+	EXPECT_NEAR(out.plane().heightAt(2.0, 0.1), s * 0.1, 0.005);
+}
+
+TEST(RrtGroundDetector, UpperStoreyFloorAtTenMetres)
+{
+	// The same floor + wall scene 10 m up (map frame of a multi-storey building).
+	ElevationGrid grid;
+	std::mt19937 rng(1);
+	gam::BinnedPoints b;
+	gamtest::sampleSurfaceIf(grid, FloorWallBox::isFloor, [](double, double) { return 10.0; }, 3, 0.003, rng, b);
+	gamtest::sampleColumns(grid, 2.5, 2.6, -3, 3, 10.0, 12.0, 0.05, b);
+	gamtest::insertAll(grid, b);
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(grid, {0, 0, 10}, out);
+	ASSERT_EQ(out.status, Status::Ok) << out.describe();
+	EXPECT_LT(rad2deg(out.plane().tiltAngle()), 0.5);
+	EXPECT_NEAR(out.plane().heightAt(0, 0), 10.0, 0.005);
+	for (const auto& n : out.nodes) EXPECT_TRUE(FloorWallBox::isFloor(n.x, n.y));
+	// Expecting the ground floor there finds nothing.
+	det.detect(grid, {0, 0, 0}, out);
+	EXPECT_EQ(out.status, Status::NoValidSeed);
+}
+
+TEST(RrtGroundDetector, SparseFloorNeedsIdw)
+{
+	// Only every other cell in x and y observed: each 3x3 neighbourhood has at
+	// most 4 observed cells (< min_valid_cells = 5) -> no seed. IDW fills the
+	// gaps and the floor is found; the estimates never become observations.
+	ElevationGrid grid;
+	std::mt19937 rng(1);
+	gam::BinnedPoints b;
+	const GridGeometry& g = grid.geometry();
+	gamtest::sampleSurfaceIf(
+		grid,
+		[&](double x, double y) {
+			return gamtest::inRect(x, y, -3, 3, -3, 3) && g.ix(x) % 2 == 0 && g.iy(y) % 2 == 0;
+		},
+		[](double, double) { return 0.0; }, 2, 0.003, rng, b);
+	gamtest::insertAll(grid, b);
+	const size_t observed = grid.observedCount();
+	ASSERT_EQ(observed, 60u * 60u);
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(grid, {0, 0, 0}, out);
+	EXPECT_EQ(out.status, Status::NoValidSeed);
+
+	IdwParams ip;
+	ip.radius_cells = 1;
+	EXPECT_GT(grid.interpolateIdw(ip), 3000u);
+	EXPECT_EQ(grid.observedCount(), observed);
+	det.detect(grid, {0, 0, 0}, out);
+	ASSERT_EQ(out.status, Status::Ok) << out.describe();
+	EXPECT_NEAR(out.plane().heightAt(0, 0), 0.0, 0.005);
+	EXPECT_LT(rad2deg(out.plane().tiltAngle()), 0.5);
+}
