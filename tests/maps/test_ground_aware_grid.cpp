@@ -179,6 +179,42 @@ TEST(GroundAwareGrid, LeddarScanFusesThroughTheBeamModel)
 	EXPECT_LT(pOcc(g, 1.5, 0.0), 0.4);
 }
 
+TEST(GroundAwareGrid, LeddarBeamsOverAHoleDoNotClearIt)
+{
+	// The Leddar at 0.3 m sees the wall at 3 m over the hole and the box: its
+	// free-space rays must not erase what the depth camera found below them.
+	auto scene = holeAndBoxScene();
+	mrpt::obs::CObservation2DRangeScan s;
+	s.aperture = float(DEG2RAD(45.0));
+	s.maxRange = 50;
+	s.sensorPose = CPose3D(0.2, 0, 0.3, 0, 0, 0);
+	s.resizeScan(16);
+	for (size_t i = 0; i < 16; i++)
+	{
+		const double a = -s.aperture / 2 + (i + 0.5) * s.aperture / 16;
+		s.setScanRange(i, float(2.8 / std::cos(a)));
+		s.setScanRangeValidity(i, true);
+	}
+	for (bool keep : {true, false})
+	{
+		CGroundAwareOccupancyGrid g;
+		g.groundOptions.scan_keeps_3d_obstacles = keep;
+		g.insertObservation(*testscene::renderDepth(scene, kKinect));
+		const double hole = pOcc(g, 2.2, 0.0), box = pOcc(g, 1.6, 0.7), floor = pOcc(g, 1.0, 0.0);
+		ASSERT_GT(hole, 0.7);
+		for (int k = 0; k < 5; k++) g.insertObservation(s);
+		if (keep)
+		{
+			EXPECT_DOUBLE_EQ(pOcc(g, 2.2, 0.0), hole);
+			EXPECT_DOUBLE_EQ(pOcc(g, 1.6, 0.7), box);
+			EXPECT_LT(pOcc(g, 1.0, 0.0), floor) << "free floor still gets freer";
+		}
+		else
+			EXPECT_LT(pOcc(g, 2.2, 0.0), 0.5) << "the plain beam model erases the hole";
+		EXPECT_GT(pOcc(g, 3.0, 0.0), 0.6) << "the wall";
+	}
+}
+
 TEST(GroundAwareGrid, MalformedObservationsThrowClearErrors)
 {
 	auto obs = testscene::renderDepth(holeAndBoxScene(), kKinect);

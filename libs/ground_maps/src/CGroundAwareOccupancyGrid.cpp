@@ -109,7 +109,8 @@ gam::ini::Fields CGroundAwareOccupancyGrid::TGroundAwareOptions::fields()
 		{"local_planes", &local_planes, 0, 1, "use ramp patches near their nodes"},
 		{"plane_support_radius", &plane_support_radius, 0, 100, "reach of a ramp patch around its nodes [m]"},
 		// 2D scans
-		{"sparse_scan_upsampling", &sparse_scan_upsampling, 1, 1000, "rays per beam for scans with < 64 beams"}};
+		{"sparse_scan_upsampling", &sparse_scan_upsampling, 1, 1000, "rays per beam for scans with < 64 beams"},
+		{"scan_keeps_3d_obstacles", &scan_keeps_3d_obstacles, 0, 1, "2D scans may not free cells that are more likely occupied"}};
 }
 
 void CGroundAwareOccupancyGrid::TGroundAwareOptions::loadFromConfigFile(
@@ -252,17 +253,44 @@ bool CGroundAwareOccupancyGrid::internal_insertObservation(
 	using namespace mrpt::obs;
 	const mrpt::poses::CPose3D pose = robotPose ? *robotPose : mrpt::poses::CPose3D();
 	if (const auto* o2 = dynamic_cast<const CObservation2DRangeScan*>(&obs))
-	{
-		if (int(o2->getScanSize()) < 64 && groundOptions.sparse_scan_upsampling > 1)
-		{
-			const auto up = upsampleSparseScan(*o2, groundOptions.sparse_scan_upsampling);
-			return COccupancyGridMap2D::internal_insertObservation(up, robotPose);
-		}
-		return COccupancyGridMap2D::internal_insertObservation(obs, robotPose);
-	}
+		return insert2D(*o2, robotPose);
 	if (IS_CLASS(obs, CObservation3DRangeScan) || IS_CLASS(obs, CObservationPointCloud))
 		return insert3D(obs, pose);
 	return COccupancyGridMap2D::internal_insertObservation(obs, robotPose);
+}
+
+bool CGroundAwareOccupancyGrid::insert2D(
+	const mrpt::obs::CObservation2DRangeScan& scan, const std::optional<const mrpt::poses::CPose3D>& robotPose)
+{
+	const bool sparse = int(scan.getScanSize()) < 64 && groundOptions.sparse_scan_upsampling > 1;
+	const auto up = sparse ? upsampleSparseScan(scan, groundOptions.sparse_scan_upsampling)
+						   : mrpt::obs::CObservation2DRangeScan();
+	const auto& use = sparse ? up : scan;
+	if (!groundOptions.scan_keeps_3d_obstacles)
+		return COccupancyGridMap2D::internal_insertObservation(use, robotPose);
+
+	// A planar beam sees only its own height: passing over a hole, a cable or
+	// a 5 cm box says nothing about them. So the beam model may add evidence,
+	// but may not make a cell that is now more likely occupied any freer.
+	const std::vector<cellType> before = m_map;
+	const float x0 = getXMin(), y0 = getYMin();
+	const int sx0 = int(getSizeX()), sy0 = int(getSizeY());
+	const bool changed = COccupancyGridMap2D::internal_insertObservation(use, robotPose);
+	const int sx = int(getSizeX()), sy = int(getSizeY());
+	// The grid may have grown (cell alignment is kept): shift the old indices.
+	const int ox = int(std::lround((x0 - getXMin()) / getResolution()));
+	const int oy = int(std::lround((y0 - getYMin()) / getResolution()));
+	for (int cy = 0; cy < sy0; cy++)
+		for (int cx = 0; cx < sx0; cx++)
+		{
+			const cellType old = before[size_t(cy) * size_t(sx0) + size_t(cx)];
+			if (old >= 0) continue;	 // free or unknown before: any update is fine
+			const int nx = cx + ox, ny = cy + oy;
+			if (nx < 0 || ny < 0 || nx >= sx || ny >= sy) continue;
+			cellType& now = m_map[size_t(ny) * size_t(sx) + size_t(nx)];
+			if (now > old) now = old;
+		}
+	return changed;
 }
 
 bool CGroundAwareOccupancyGrid::insert3D(

@@ -89,6 +89,10 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		double plane_support_radius = 0.4;
 		// 2D scans
 		int sparse_scan_upsampling = 8;	 ///< rays per beam for scans of < 64 beams (Leddar)
+		/** A planar beam passes over holes, cables and small boxes: with this
+		 * on, 2D scans add hits and free space but never make a cell that is
+		 * more likely occupied any freer. */
+		bool scan_keeps_3d_obstacles = true;
 
 		gam::ini::Fields fields();
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
@@ -139,6 +143,9 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 
    private:
 	bool insert3D(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose);
+	bool insert2D(
+		const mrpt::obs::CObservation2DRangeScan& scan,
+		const std::optional<const mrpt::poses::CPose3D>& robotPose);
 	void applyEvidence();
 
 	// Per-frame workspace (not serialized).
