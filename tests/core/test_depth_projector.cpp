@@ -486,3 +486,48 @@ TEST(DepthProjector, RejectsInconsistentInputs)
 	EXPECT_NO_THROW(proj.project(img.view(), camera(), T, f, grid, out));
 	EXPECT_EQ(out.size(), size_t(W * H));
 }
+
+TEST(DepthProjector, LensDistortionIsInvertedInTheRayTable)
+{
+	// Each ray (1, ky, kz) of the table is the undistorted normalized point
+	// (xu, yu) = (-ky, -kz); distorting it with the Brown-Conrady model
+	// (MRPT's TCamera::dist order k1, k2, p1, p2, k3) must give back the pixel.
+	PinholeIntrinsics K = camera();
+	K.k1 = 0.12;
+	K.k2 = -0.05;
+	K.p1 = 0.001;
+	K.p2 = -0.002;
+	K.k3 = 0.01;
+	DepthProjector proj;
+	ElevationGrid grid;
+	BinnedPoints out;
+	Image img;
+	proj.project(img.view(), K, RigidTransform{}, ProjectionFilter{}, grid, out);
+	ASSERT_EQ(proj.rayLut().size(), size_t(W * H));
+	for (int r = 0; r < H; r += 7)
+		for (int c = 0; c < W; c += 9)
+		{
+			const auto& k = proj.rayLut()[size_t(r) * W + size_t(c)];
+			const double xu = -k.x(), yu = -k.y();
+			const double r2 = xu * xu + yu * yu;
+			const double radial = 1 + K.k1 * r2 + K.k2 * r2 * r2 + K.k3 * r2 * r2 * r2;
+			const double xd = xu * radial + 2 * K.p1 * xu * yu + K.p2 * (r2 + 2 * xu * xu);
+			const double yd = yu * radial + K.p1 * (r2 + 2 * yu * yu) + 2 * K.p2 * xu * yu;
+			EXPECT_NEAR(xd, (c - K.cx) / K.fx, 2e-6) << r << "," << c;
+			EXPECT_NEAR(yd, (r - K.cy) / K.fy, 2e-6) << r << "," << c;
+		}
+	// Barrel distortion (k1 > 0): the corner ray is less oblique than the
+	// distorted pixel position says.
+	const auto& corner = proj.rayLut()[0];
+	EXPECT_LT(std::abs(corner.x()), 31.5 / 50.0);
+	EXPECT_LT(std::abs(corner.y()), 23.5 / 50.0);
+
+	// The table follows the intrinsics: back to no distortion.
+	proj.project(img.view(), camera(), RigidTransform{}, ProjectionFilter{}, grid, out);
+	EXPECT_NEAR(proj.rayLut()[0].x(), 31.5 / 50.0, 1e-6);
+	EXPECT_NEAR(proj.rayLut()[0].y(), 23.5 / 50.0, 1e-6);
+
+	K = camera();
+	K.k1 = NAN;
+	EXPECT_THROW(proj.project(img.view(), K, RigidTransform{}, ProjectionFilter{}, grid, out), std::invalid_argument);
+}
