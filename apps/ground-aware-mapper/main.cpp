@@ -1,6 +1,7 @@
 // ground-aware-mapper: builds the ground-aware grid and the comparison maps
 // from a rawlog. All the work is in libs/mapper (gam::mapper::Mapper).
 #include <default_config.h>
+#include <gam/mapper/Errors.h>
 #include <gam/mapper/Mapper.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/maps/registerGroundAwareMaps.h>
@@ -119,6 +120,6 @@ int main(int argc, char** argv)
 	}
 	catch (const std::exception& e)
 	{
-		return fail(1, e.what());
+		return fail(1, gam::mapper::conciseError(e.what()));
 	}
 }

@@ -1,3 +1,4 @@
+#include <gam/mapper/Errors.h>
 #include <gam/mapper/GridIO.h>
 #include <gam/mapper/Mapper.h>
 #include <gam/mapper/RawlogFrames.h>
@@ -36,20 +37,7 @@ namespace gam::mapper
 {
 namespace
 {
-std::string firstLine(const std::string& s)
-{
-	// MRPT exceptions carry a multi-line trace: keep the most specific line.
-	std::istringstream ss(s);
-	std::string line, best;
-	while (std::getline(ss, line))
-	{
-		if (line.find_first_not_of(" \t=") == std::string::npos) continue;
-		if (line.find("Message:") != std::string::npos)
-			return line.substr(line.find("Message:") + 8);
-		if (best.empty()) best = line;
-	}
-	return best.empty() ? s : best;
-}
+std::string firstLine(const std::string& s) { return conciseError(s); }
 
 std::string trim(std::string s)
 {
@@ -340,7 +328,18 @@ RunSummary Mapper::run()
 	const auto tStart = clk::now();
 	RunSummary s;
 
-	// 1. Output directory: create it and a private temporary folder inside it,
+	// 1. Input (before touching DIR).
+	std::unique_ptr<RawlogFrameReader> reader;
+	try
+	{
+		reader = std::make_unique<RawlogFrameReader>(m_opts.rawlogPath);
+	}
+	catch (const std::exception& e)
+	{
+		throw RunError(e.what());
+	}
+
+	// 2. Output directory: create it and a private temporary folder inside it,
 	// so nothing in DIR looks like a finished map until the very end.
 	std::error_code ec;
 	fs::create_directories(m_opts.outDir, ec);
@@ -352,17 +351,6 @@ RunSummary Mapper::run()
 	if (!fs::create_directory(tmp.path, ec))
 		throw RunError("output directory " + m_opts.outDir + " is not writable" + (ec ? ": " + ec.message() : ""));
 	tmp.path = tmp.path;  // cleaned up by ~TmpDir unless kept
-
-	// 2. Input.
-	std::unique_ptr<RawlogFrameReader> reader;
-	try
-	{
-		reader = std::make_unique<RawlogFrameReader>(m_opts.rawlogPath);
-	}
-	catch (const std::exception& e)
-	{
-		throw RunError(e.what());
-	}
 
 	std::ofstream timing(tmp.path + "/timing.csv"), planes(tmp.path + "/ground_planes.csv");
 	if (!timing || !planes) throw RunError("cannot write to " + tmp.path);

@@ -1,3 +1,4 @@
+#include <gam/mapper/Errors.h>
 #include <gam/mapper/RawlogFrames.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/obs/CActionCollection.h>
@@ -72,7 +73,7 @@ bool RawlogFrameReader::next(Frame& f)
 			{
 				throw std::runtime_error(
 					"rawlog entry " + std::to_string(p.entry) + ": cannot load external data of " +
-					p.obs->GetRuntimeClass()->className + " (" + std::string(e.what()).substr(0, 200) + ")");
+					p.obs->GetRuntimeClass()->className + " (" + conciseError(e.what()) + ")");
 			}
 			if (!isUsableScan(*p.obs))
 			{
@@ -101,10 +102,7 @@ bool RawlogFrameReader::next(Frame& f)
 		}
 		catch (const std::exception& e)
 		{
-			std::string msg = e.what();
-			// First meaningful line of MRPT's multi-line exception text.
-			const auto nl = msg.find('\n');
-			if (nl != std::string::npos) msg = msg.substr(0, nl);
+			const std::string msg = conciseError(e.what());
 			throw std::runtime_error(
 				"cannot read rawlog " + m_path + " at entry " + std::to_string(m_entry) +
 				" (not a rawlog, corrupt, or a class from a plugin that is not loaded): " + msg);

@@ -1,0 +1,537 @@
+// End-to-end tests of ground-aware-mapper: run the real executable on a real
+// rawlog and on generated ones (both rawlog formats), and check every output.
+#include <gam/mapper/GridIO.h>
+#include <gtest/gtest.h>
+#include <mrpt/img/CImage.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/maps/CElevation25DMap.h>
+#include <mrpt/maps/registerGroundAwareMaps.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <unistd.h>
+
+#include <array>
+#include <set>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using mrpt::maps::COccupancyGridMap2D;
+using namespace gam::mapper;
+
+namespace
+{
+const std::string kExe = GAM_MAPPER_EXE;
+const std::string kTmp = GAM_TEST_TMP_DIR;
+const std::string kMilk = std::string(GAM_REAL_DATA_DIR) + "/pcl_milk_bottles_on_carpet/pcl_milk_bottles_on_carpet.rawlog";
+const std::vector<std::string> kGrids = {"ground_aware", "height_band", "octomap"};
+
+struct RunResult
+{
+	int rc = -1;
+	std::string out, err;
+};
+
+std::string slurp(const std::string& f)
+{
+	std::ifstream i(f, std::ios::binary);
+	std::ostringstream s;
+	s << i.rdbuf();
+	return s.str();
+}
+
+RunResult runMapper(const std::string& args)
+{
+	static int n = 0;
+	fs::create_directories(kTmp);
+	const std::string o = kTmp + "/run" + std::to_string(getpid()) + "_" + std::to_string(n) + ".out";
+	const std::string e = kTmp + "/run" + std::to_string(getpid()) + "_" + std::to_string(n++) + ".err";
+	const std::string cmd = "'" + kExe + "' " + args + " >'" + o + "' 2>'" + e + "' </dev/null";
+	const int st = std::system(cmd.c_str());
+	RunResult r;
+	r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+	r.out = slurp(o);
+	r.err = slurp(e);
+	return r;
+}
+
+std::string freshDir(const std::string& name)
+{
+	const std::string d = kTmp + "/" + name;
+	fs::remove_all(d);
+	return d;
+}
+
+// ------------------------------------------------------------ synthetic scene
+struct Box
+{
+	double x0, x1, y0, y1, z0, z1;
+};
+// Floor (top z = 0, thick) with a 0.5 x 0.5 m hole 0.5 m deep, and a box.
+const Box kBoxObstacle{1.4, 1.7, 0.3, 0.7, 0.0, 0.5};
+const Box kHole{2.0, 2.5, -0.6, -0.1, -0.5, 0.0};  // the empty part
+const std::vector<Box> kScene = {
+	{-10, 2.0, -10, 10, -1, 0}, {2.5, 10, -10, 10, -1, 0}, {2.0, 2.5, -10, -0.6, -1, 0},
+	{2.0, 2.5, -0.1, 10, -1, 0}, {2.0, 2.5, -0.6, -0.1, -1, -0.5}, kBoxObstacle};
+
+double rayBox(const mrpt::math::TPoint3D& o, const mrpt::math::TPoint3D& d, const Box& b)
+{
+	double t0 = 0, t1 = std::numeric_limits<double>::infinity();
+	const double lo[3] = {b.x0, b.y0, b.z0}, hi[3] = {b.x1, b.y1, b.z1};
+	const double oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
+	for (int k = 0; k < 3; k++)
+	{
+		if (std::abs(dd[k]) < 1e-12)
+		{
+			if (oo[k] < lo[k] || oo[k] > hi[k]) return -1;
+			continue;
+		}
+		double a = (lo[k] - oo[k]) / dd[k], c = (hi[k] - oo[k]) / dd[k];
+		if (a > c) std::swap(a, c);
+		t0 = std::max(t0, a);
+		t1 = std::min(t1, c);
+		if (t0 > t1) return -1;
+	}
+	return t0;
+}
+
+mrpt::obs::CObservation3DRangeScan::Ptr makeFrame(double robotX)
+{
+	const int W = 160, H = 120;
+	const double fx = 120, fy = 120, cx = 79.5, cy = 59.5;
+	auto o = mrpt::obs::CObservation3DRangeScan::Create();
+	o->sensorLabel = "DEPTH";
+	o->timestamp = mrpt::Clock::fromDouble(1000.0 + robotX);
+	o->hasRangeImage = true;
+	o->range_is_depth = true;
+	o->rangeUnits = 0.001f;
+	o->maxRange = 5.0f;
+	o->sensorPose = mrpt::poses::CPose3D(0.1, 0, 0.6, 0, mrpt::DEG2RAD(30.0), 0);
+	o->cameraParams.ncols = W;
+	o->cameraParams.nrows = H;
+	o->cameraParams.setIntrinsicParamsFromValues(fx, fy, cx, cy);
+	o->cameraParamsIntensity = o->cameraParams;
+	o->rangeImage_setSize(H, W);
+	const mrpt::poses::CPose3D sensorInWorld = mrpt::poses::CPose3D(robotX, 0, 0, 0, 0, 0) + o->sensorPose;
+	const auto R = sensorInWorld.getRotationMatrix();
+	const mrpt::math::TPoint3D org(sensorInWorld.x(), sensorInWorld.y(), sensorInWorld.z());
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+		{
+			const double ds[3] = {1.0, (cx - c) / fx, (cy - r) / fy};
+			mrpt::math::TPoint3D d(
+				R(0, 0) * ds[0] + R(0, 1) * ds[1] + R(0, 2) * ds[2], R(1, 0) * ds[0] + R(1, 1) * ds[1] + R(1, 2) * ds[2],
+				R(2, 0) * ds[0] + R(2, 1) * ds[1] + R(2, 2) * ds[2]);
+			double best = std::numeric_limits<double>::infinity();
+			for (const auto& b : kScene)
+			{
+				const double t = rayBox(org, d, b);
+				if (t > 1e-6 && t < best) best = t;
+			}
+			// t is the depth along the sensor +X axis (ds has x = 1).
+			o->rangeImage(r, c) = (std::isfinite(best) && best < 4.99) ? uint16_t(std::lround(best / 0.001)) : 0;
+		}
+	return o;
+}
+
+const std::vector<double> kPosesX = {0.0, 0.25, 0.5, 0.75};
+
+void writeObsFormat(const std::string& path)
+{
+	mrpt::io::CFileGZOutputStream f(path);
+	auto ar = mrpt::serialization::archiveFrom(f);
+	for (double x : kPosesX)
+	{
+		auto odo = mrpt::obs::CObservationOdometry::Create();
+		odo->sensorLabel = "ODOMETRY";
+		odo->odometry = mrpt::poses::CPose2D(x, 0, 0);
+		ar << *odo;
+		ar << *makeFrame(x);
+	}
+}
+
+void writeSfFormat(const std::string& path)
+{
+	mrpt::io::CFileGZOutputStream f(path);
+	auto ar = mrpt::serialization::archiveFrom(f);
+	double prev = 0;
+	for (double x : kPosesX)
+	{
+		mrpt::obs::CActionCollection acts;
+		mrpt::obs::CActionRobotMovement2D mov;
+		mrpt::obs::CActionRobotMovement2D::TMotionModelOptions mm;
+		mov.computeFromOdometry(mrpt::poses::CPose2D(x - prev, 0, 0), mm);
+		acts.insert(mov);
+		prev = x;
+		mrpt::obs::CSensoryFrame sf;
+		sf.insert(makeFrame(x));
+		ar << acts << sf;
+	}
+}
+
+/** p_free of the cell at (x, y). */
+double pFree(const COccupancyGridMap2D& g, double x, double y) { return g.getPos(float(x), float(y)); }
+/** The cells whose centre lies in the rectangle. */
+template <class F>
+void forCellsIn(const COccupancyGridMap2D& g, double x0, double x1, double y0, double y1, F f)
+{
+	for (int cy = std::max(0, g.y2idx(y0) - 1); cy <= std::min(int(g.getSizeY()) - 1, g.y2idx(y1) + 1); cy++)
+		for (int cx = std::max(0, g.x2idx(x0) - 1); cx <= std::min(int(g.getSizeX()) - 1, g.x2idx(x1) + 1); cx++)
+		{
+			const double x = g.idx2x(cx), y = g.idx2y(cy);
+			if (x >= x0 && x <= x1 && y >= y0 && y <= y1) f(double(g.getCell(cx, cy)));
+		}
+}
+/** Lowest p_free over the cells inside a rectangle. */
+double minPFree(const COccupancyGridMap2D& g, double x0, double x1, double y0, double y1)
+{
+	double m = 1;
+	forCellsIn(g, x0, x1, y0, y1, [&](double p) { m = std::min(m, p); });
+	return m;
+}
+double fractionOccupied(const COccupancyGridMap2D& g, double x0, double x1, double y0, double y1)
+{
+	int n = 0, occ = 0;
+	forCellsIn(g, x0, x1, y0, y1, [&](double p) {
+		n++;
+		if (p < 0.4) occ++;
+	});
+	return n ? double(occ) / n : 0;
+}
+
+/** Every output of one run exists and parses; the PGM/PNG match the grid. */
+void checkOutputs(const std::string& dir)
+{
+	for (const auto& name : kGrids)
+	{
+		SCOPED_TRACE(name);
+		const std::string base = dir + "/" + name;
+		for (const char* ext : {".yaml", ".pgm", ".gridmap.gz", ".png"})
+			ASSERT_TRUE(fs::exists(base + ext)) << base + ext;
+		const RosMapYaml y = readRosYaml(base + ".yaml");
+		const PgmImage pgm = readPgm(base + ".pgm");
+		const COccupancyGridMap2D g = readGridmapGz(base + ".gridmap.gz");
+		EXPECT_EQ(y.image, name + ".pgm");
+		EXPECT_EQ(y.mode, "scale");
+		EXPECT_EQ(y.negate, 0);
+		EXPECT_NEAR(y.resolution, g.getResolution(), 1e-6);
+		EXPECT_NEAR(y.origin_x, g.getXMin(), 1e-4);
+		EXPECT_NEAR(y.origin_y, g.getYMin(), 1e-4);
+		ASSERT_EQ(pgm.width, int(g.getSizeX()));
+		ASSERT_EQ(pgm.height, int(g.getSizeY()));
+		size_t bad = 0, occupied = 0;
+		for (int row = 0; row < pgm.height; row++)
+			for (int x = 0; x < pgm.width; x++)
+			{
+				const int cy = pgm.height - 1 - row;  // first row = highest y
+				const double pOcc = 1.0 - double(g.getCell(x, cy));
+				const int expect = int(std::lround(255.0 * (1.0 - pOcc)));
+				if (std::abs(int(pgm.at(x, row)) - expect) > 0) bad++;
+				if (pOcc > 0.6) occupied++;
+			}
+		EXPECT_EQ(bad, 0u) << "PGM pixels differ from round(255*(1-p_occ))";
+		EXPECT_GT(occupied, 0u) << "no occupied cell at all";
+
+		mrpt::img::CImage png;
+		ASSERT_TRUE(png.loadFromFile(base + ".png"));
+		const PngView v = pngViewOf(g);
+		ASSERT_EQ(int(png.getWidth()), v.w * v.scale);
+		ASSERT_EQ(int(png.getHeight()), v.h * v.scale);
+		size_t pbad = 0;
+		for (int py = 0; py < int(png.getHeight()); py += 1)
+			for (int px = 0; px < int(png.getWidth()); px += 1)
+			{
+				const int cx = v.cx0 + px / v.scale, cy = v.cy0 + v.h - 1 - py / v.scale;
+				// CImage keeps OpenCV's BGR channel order.
+				struct
+				{
+					uint8_t R, G, B;
+				} c{png.at<uint8_t>(px, py, 2), png.at<uint8_t>(px, py, 1), png.at<uint8_t>(px, py, 0)};
+				const auto raw = g.getRawMap()[size_t(cx) + size_t(cy) * g.getSizeX()];
+				if (raw == 0)
+				{
+					if (!(c.R == kUnknownR && c.G == kUnknownG && c.B == kUnknownB)) pbad++;
+				}
+				else
+				{
+					const uint8_t p = pgmValue(raw);
+					if (!(c.R == p && c.G == p && c.B == p)) pbad++;
+				}
+			}
+		EXPECT_EQ(pbad, 0u) << "PNG pixels differ from the grid";
+	}
+	// Elevation map.
+	for (const char* f : {"elevation.png", "elevation_span.png", "elevation_count.png", "elevation.map.gz"})
+		EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
+	{
+		mrpt::maps::registerGroundAwareMaps();
+		mrpt::io::CFileGZInputStream fi(dir + "/elevation.map.gz");
+		mrpt::maps::CElevation25DMap em;
+		mrpt::serialization::archiveFrom(fi) >> em;
+		EXPECT_FALSE(em.isEmpty());
+	}
+	// CSVs.
+	{
+		std::ifstream f(dir + "/ground_planes.csv");
+		std::string h;
+		std::getline(f, h);
+		EXPECT_EQ(h, "frame,a,b,c,d,nodes,status");
+	}
+	{
+		std::ifstream f(dir + "/timing.csv");
+		std::string h, line;
+		std::getline(f, h);
+		EXPECT_EQ(h, "frame,map,stage,ms");
+		std::set<std::string> maps;
+		while (std::getline(f, line))
+		{
+			std::vector<std::string> c;
+			std::stringstream ss(line);
+			std::string t;
+			while (std::getline(ss, t, ',')) c.push_back(t);
+			ASSERT_EQ(c.size(), 4u) << line;
+			maps.insert(c[1]);
+			EXPECT_GE(std::stod(c[3]), 0.0);
+		}
+		for (const auto& n : kGrids) EXPECT_TRUE(maps.count(n)) << n;
+		EXPECT_TRUE(maps.count("elevation"));
+	}
+	// Nothing temporary left behind.
+	for (const auto& de : fs::directory_iterator(dir))
+		EXPECT_NE(de.path().filename().string().rfind(".ground-aware-mapper.tmp", 0), 0u) << de.path();
+}
+
+class MapperE2E : public ::testing::Test
+{
+   protected:
+	static void SetUpTestSuite()
+	{
+		fs::create_directories(kTmp);
+		obsRawlog = kTmp + "/scene_obs.rawlog";
+		sfRawlog = kTmp + "/scene_sf.rawlog";
+		writeObsFormat(obsRawlog);
+		writeSfFormat(sfRawlog);
+		obsOut = freshDir("out_obs");
+		sfOut = freshDir("out_sf");
+		obsRun = runMapper("--rawlog '" + obsRawlog + "' --out '" + obsOut + "'");
+		sfRun = runMapper("--rawlog '" + sfRawlog + "' --out '" + sfOut + "'");
+	}
+	static std::string obsRawlog, sfRawlog, obsOut, sfOut;
+	static RunResult obsRun, sfRun;
+};
+std::string MapperE2E::obsRawlog, MapperE2E::sfRawlog, MapperE2E::obsOut, MapperE2E::sfOut;
+RunResult MapperE2E::obsRun, MapperE2E::sfRun;
+
+}  // namespace
+
+// ----------------------------------------------------------------- tests
+TEST(MapperReal, MilkBottlesAllOutputsParseAndMatch)
+{
+	if (!fs::exists(kMilk)) GTEST_SKIP() << "missing " << kMilk;
+	const std::string out = freshDir("out_milk");
+	const auto r = runMapper("--rawlog '" + kMilk + "' --out '" + out + "'");
+	ASSERT_EQ(r.rc, 0) << r.err;
+	EXPECT_NE(r.out.find("frames: 1 "), std::string::npos) << r.out;
+	for (const auto& n : kGrids) EXPECT_NE(r.out.find(n), std::string::npos) << r.out;
+	EXPECT_NE(r.out.find("median_ms"), std::string::npos);
+	checkOutputs(out);
+	// One frame, ground found: the plane is the floor (robot frame z = 0).
+	std::ifstream f(out + "/ground_planes.csv");
+	std::string h, row;
+	std::getline(f, h);
+	ASSERT_TRUE(std::getline(f, row));
+	EXPECT_NE(row.find(",ok"), std::string::npos) << row;
+	// The bottles (0.21-0.26 m tall, 0.5-0.8 m ahead) are obstacles in the ground-aware grid.
+	const auto g = readGridmapGz(out + "/ground_aware.gridmap.gz");
+	EXPECT_GT(fractionOccupied(g, 0.4, 0.9, -0.4, 0.4), 0.0);
+}
+
+TEST_F(MapperE2E, GeneratedRunsSucceedAndOutputsParse)
+{
+	ASSERT_EQ(obsRun.rc, 0) << obsRun.err;
+	ASSERT_EQ(sfRun.rc, 0) << sfRun.err;
+	EXPECT_NE(obsRun.out.find("frames: 4 "), std::string::npos) << obsRun.out;
+	EXPECT_NE(sfRun.out.find("frames: 4 "), std::string::npos) << sfRun.out;
+	checkOutputs(obsOut);
+	checkOutputs(sfOut);
+}
+
+TEST_F(MapperE2E, BothRawlogFormatsGiveTheSameMaps)
+{
+	ASSERT_EQ(obsRun.rc, 0);
+	ASSERT_EQ(sfRun.rc, 0);
+	for (const auto& n : kGrids)
+	{
+		SCOPED_TRACE(n);
+		const auto a = readGridmapGz(obsOut + "/" + n + ".gridmap.gz");
+		const auto b = readGridmapGz(sfOut + "/" + n + ".gridmap.gz");
+		ASSERT_EQ(a.getSizeX(), b.getSizeX());
+		ASSERT_EQ(a.getSizeY(), b.getSizeY());
+		EXPECT_FLOAT_EQ(a.getXMin(), b.getXMin());
+		EXPECT_FLOAT_EQ(a.getYMin(), b.getYMin());
+		EXPECT_TRUE(a.getRawMap() == b.getRawMap());
+		EXPECT_EQ(slurp(obsOut + "/" + n + ".pgm"), slurp(sfOut + "/" + n + ".pgm"));
+	}
+	EXPECT_EQ(slurp(obsOut + "/ground_planes.csv"), slurp(sfOut + "/ground_planes.csv"));
+}
+
+TEST_F(MapperE2E, KnownCellsHaveTheExpectedState)
+{
+	ASSERT_EQ(obsRun.rc, 0);
+	const auto ga = readGridmapGz(obsOut + "/ground_aware.gridmap.gz");
+	const auto hb = readGridmapGz(obsOut + "/height_band.gridmap.gz");
+	const auto oc = readGridmapGz(obsOut + "/octomap.gridmap.gz");
+	const Box& b = kBoxObstacle;
+	// Box: occupied in all three (its front face at x = 1.4).
+	EXPECT_LT(minPFree(ga, b.x0 - 0.05, b.x0 + 0.1, b.y0 + 0.05, b.y1 - 0.05), 0.3);
+	EXPECT_LT(minPFree(hb, b.x0 - 0.05, b.x0 + 0.1, b.y0 + 0.05, b.y1 - 0.05), 0.3);
+	EXPECT_LT(minPFree(oc, b.x0 - 0.05, b.x0 + 0.1, b.y0 + 0.05, b.y1 - 0.05), 0.3);
+	// Floor in front of the robot: free in the ground-aware grid.
+	EXPECT_GT(pFree(ga, 1.02, -0.48), 0.6);
+	EXPECT_GT(pFree(ga, 1.87, -0.82), 0.6);
+	// Hole: occupied in the ground-aware grid, invisible to the height band.
+	const Box& h = kHole;
+	EXPECT_GT(fractionOccupied(ga, h.x0 + 0.05, h.x1 - 0.05, h.y0 + 0.05, h.y1 - 0.05), 0.5);
+	EXPECT_DOUBLE_EQ(fractionOccupied(hb, h.x0, h.x1, h.y0, h.y1), 0.0);
+	EXPECT_GE(minPFree(hb, h.x0, h.x1, h.y0, h.y1), 0.5);
+}
+
+TEST_F(MapperE2E, LocalMapModeKeepsARobotCentredWindow)
+{
+	const std::string out = freshDir("out_local");
+	const auto r = runMapper("--rawlog '" + obsRawlog + "' --out '" + out + "' --local-map --local-size-cells 80 -q");
+	ASSERT_EQ(r.rc, 0) << r.err;
+	for (const auto& n : kGrids)
+	{
+		SCOPED_TRACE(n);
+		const auto g = readGridmapGz(out + "/" + n + ".gridmap.gz");
+		EXPECT_EQ(g.getSizeX(), 80u);
+		EXPECT_EQ(g.getSizeY(), 80u);
+		// Centred on the last robot pose (x = 0.75, y = 0) within a cell.
+		EXPECT_NEAR(0.5 * (g.getXMin() + g.getXMax()), kPosesX.back(), g.getResolution());
+		EXPECT_NEAR(0.5 * (g.getYMin() + g.getYMax()), 0.0, g.getResolution());
+	}
+	const auto ga = readGridmapGz(out + "/ground_aware.gridmap.gz");
+	const auto full = readGridmapGz(obsOut + "/ground_aware.gridmap.gz");
+	// Inside the window the local map equals the global one.
+	EXPECT_FLOAT_EQ(pFree(ga, 1.02, -0.48), pFree(full, 1.02, -0.48));
+	EXPECT_FLOAT_EQ(pFree(ga, 1.42, 0.52), pFree(full, 1.42, 0.52));
+}
+
+TEST(MapperCli, PrintDefaultConfigIsTheConfigFile)
+{
+	const auto r = runMapper("--print-default-config");
+	ASSERT_EQ(r.rc, 0);
+	EXPECT_EQ(r.out, slurp(std::string(GAM_SOURCE_DIR) + "/config/ground-aware-mapper.ini"));
+}
+
+namespace
+{
+void expectError(const RunResult& r, int rc, const std::vector<std::string>& needles, const std::string& outDir)
+{
+	EXPECT_EQ(r.rc, rc) << r.err;
+	// Exactly one line, "ground-aware-mapper: error: ...".
+	EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+	EXPECT_EQ(r.err.rfind("ground-aware-mapper: error: ", 0), 0u) << r.err;
+	for (const auto& n : needles) EXPECT_NE(r.err.find(n), std::string::npos) << "'" << n << "' not in: " << r.err;
+	// Never a map that looks complete.
+	if (!outDir.empty() && fs::exists(outDir))
+		for (const auto& de : fs::directory_iterator(outDir))
+		{
+			const std::string f = de.path().filename().string();
+			EXPECT_EQ(f.find(".yaml"), std::string::npos) << f;
+			EXPECT_EQ(f.find(".pgm"), std::string::npos) << f;
+			EXPECT_EQ(f.find(".gridmap.gz"), std::string::npos) << f;
+		}
+}
+
+std::string withDefaultConfigEdited(const std::string& name, const std::string& from, const std::string& to)
+{
+	std::string ini = slurp(std::string(GAM_SOURCE_DIR) + "/config/ground-aware-mapper.ini");
+	const auto p = ini.find(from);
+	EXPECT_NE(p, std::string::npos) << from;
+	if (p != std::string::npos) ini.replace(p, from.size(), to);
+	const std::string f = kTmp + "/" + name + ".ini";
+	std::ofstream(f) << ini;
+	return f;
+}
+}  // namespace
+
+TEST_F(MapperE2E, BadInputsGiveOneLineErrors)
+{
+	const std::string out = freshDir("out_bad");
+	// Missing rawlog.
+	expectError(runMapper("--rawlog /nonexistent/x.rawlog --out '" + out + "'"), 1, {"not found", "x.rawlog"}, out);
+	// Unreadable (not a rawlog).
+	{
+		const std::string f = kTmp + "/garbage.rawlog";
+		std::ofstream(f) << "this is not a rawlog\n";
+		expectError(runMapper("--rawlog '" + f + "' --out '" + out + "'"), 1, {"cannot read rawlog"}, out);
+	}
+	// A rawlog with no usable observation (odometry only).
+	{
+		const std::string f = kTmp + "/odometry_only.rawlog";
+		{
+			mrpt::io::CFileGZOutputStream fo(f);
+			auto ar = mrpt::serialization::archiveFrom(fo);
+			for (int i = 0; i < 3; i++)
+			{
+				mrpt::obs::CObservationOdometry odo;
+				odo.odometry = mrpt::poses::CPose2D(0.1 * i, 0, 0);
+				ar << odo;
+			}
+		}
+		expectError(runMapper("--rawlog '" + f + "' --out '" + out + "'"), 1, {"no usable observation"}, out);
+	}
+	// Missing config file.
+	expectError(
+		runMapper("--rawlog '" + obsRawlog + "' --out '" + out + "' --config /nonexistent/c.ini"), 2, {"c.ini"}, out);
+	// Unknown key (a typo in groundOpts).
+	expectError(
+		runMapper(
+			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +
+			withDefaultConfigEdited("typo", "\nd_n=0.4", "\nd_nn=0.4") + "'"),
+		2, {"unknown key 'd_nn'", "map_groundAwareGrid_00_groundOpts"}, out);
+	// Out-of-range value: names the key and the range.
+	expectError(
+		runMapper(
+			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +
+			withDefaultConfigEdited("range", "\nK=600", "\nK=0") + "'"),
+		2, {"K=0", "out of range", "[1, 1e+06]"}, out);
+	expectError(
+		runMapper(
+			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +
+			withDefaultConfigEdited("band", "\nz_min=0.2 ", "\nz_min=200 ") + "'"),
+		2, {"z_min=200", "out of range"}, out);
+	// Unknown map type.
+	expectError(
+		runMapper(
+			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +
+			withDefaultConfigEdited("type", "heightBandGrid_count=1", "heightBandGird_count=1") + "'"),
+		2, {"unknown map type 'heightBandGird'"}, out);
+	// Unknown sub-section of one of our maps.
+	expectError(
+		runMapper(
+			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +
+			withDefaultConfigEdited("section", "[map_octoMapGrid_00_octoOpts]", "[map_octoMapGrid_00_octoOptions]") + "'"),
+		2, {"unknown section [map_octoMapGrid_00_octoOptions]"}, out);
+	// Unwritable output directory (its parent is a file).
+	{
+		const std::string file = kTmp + "/a_file";
+		std::ofstream(file) << "x";
+		expectError(runMapper("--rawlog '" + obsRawlog + "' --out '" + file + "/sub'"), 1, {"output directory"}, "");
+	}
+	// Bad command line.
+	expectError(runMapper("--rawlog '" + obsRawlog + "'"), 2, {"--out"}, "");
+	expectError(runMapper("--no-such-option"), 2, {"no-such-option"}, "");
+}
