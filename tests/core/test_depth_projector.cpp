@@ -421,6 +421,17 @@ TEST(DepthProjector, InvalidPixelsAndOutOfGridPointsAreSkipped)
 	out.clear();
 	EXPECT_EQ(proj.project(wall.view(), camera(), T, ProjectionFilter{}, shortGrid, out), 0u);
 
+	// A grid starting 1 cm beyond the wall: the points are 1 cm before its
+	// first column (not truncated into column 0); starting 2 cm before it, all
+	// land in column 0.
+	ElevationGrid after(makeGeometry(3.03, -5, 0.05, 20, 200));
+	out.clear();
+	EXPECT_EQ(proj.project(wall.view(), camera(), T, ProjectionFilter{}, after, out), 0u);
+	ElevationGrid beforeWall(makeGeometry(3.0, -5, 0.05, 20, 200));
+	out.clear();
+	EXPECT_EQ(proj.project(wall.view(), camera(), T, ProjectionFilter{}, beforeWall, out), size_t(W * H));
+	for (uint32_t idx : out.cell) EXPECT_EQ(idx % 20u, 0u);
+
 	// Row padding (stride > cols) is never read, even if it holds values.
 	Image padded(H, W, W + 5);
 	for (int r = 0; r < H; r++)
