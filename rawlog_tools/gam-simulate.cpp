@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -152,6 +153,12 @@ int main(int argc, char** argv)
 		const LeddarModel leddar(sf.leddar);
 		const mrpt::poses::CPose3D kinPose = toCPose3D(sf.kinect_pose), ledPose = toCPose3D(sf.leddar_pose);
 
+		{
+			// create the output folder if needed
+			const std::filesystem::path parent = std::filesystem::path(prefix).parent_path();
+			std::error_code ec;
+			if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+		}
 		mrpt::io::CFileGZOutputStream fo;
 		if (!fo.open(prefix + ".rawlog", 1))
 		{
