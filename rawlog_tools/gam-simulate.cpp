@@ -143,7 +143,9 @@ int main(int argc, char** argv)
 		if (argFrames.getValue() > 0 && size_t(argFrames.getValue()) < truth.size())
 			truth.resize(size_t(argFrames.getValue()));
 		const unsigned seed = argSeed.getValue();
-		std::mt19937 rngKinect(seed), rngLeddar(seed ^ 0x9e3779b9u), rngOdo(seed ^ 0x85ebca6bu);
+		std::mt19937 rngKinect(seed), rngLeddar(seed ^ 0x9e3779b9u), rngOdo(seed ^ 0x85ebca6bu),
+			rngSway(seed ^ 0xc2b2ae35u);
+		std::normal_distribution<double> gauss(0.0, 1.0);
 		const std::vector<Pose2> odo = simulateOdometry(truth, sf.odometry_noise, rngOdo);
 
 		GroundTruthGrid gt;
@@ -181,7 +183,14 @@ int main(int argc, char** argv)
 			o->odometry = mrpt::poses::CPose2D(odo[i].x, odo[i].y, odo[i].yaw);
 			ar << *o;
 
-			const DepthFrame fr = kinect.render(sf.scene, robot * sf.kinect_pose, rngKinect);
+			// the walker rocks: the real Kinect pose may differ from the nominal one
+			Pose3 sway;
+			if (noise && sf.kinect_sway > 0)
+			{
+				const double dp = sf.kinect_sway * gauss(rngSway), dr = sf.kinect_sway * gauss(rngSway);
+				sway = Pose3::fromXYZYPR(0, 0, 0, 0, dp, dr);
+			}
+			const DepthFrame fr = kinect.render(sf.scene, robot * sf.kinect_pose * sway, rngKinect);
 			gt.markObserved(fr.footprint);
 			auto k = mrpt::obs::CObservation3DRangeScan::Create();
 			k->sensorLabel = "KINECT";

@@ -199,6 +199,8 @@ SceneFile parseScene(std::istream& in, const std::string& filename)
 			k.grazing_start_deg = a.num("grazing_start", k.grazing_start_deg);
 			k.grazing_end_deg = a.num("grazing_end", k.grazing_end_deg);
 			if (!(k.grazing_end_deg > k.grazing_start_deg)) a.fail("grazing_end must be > grazing_start");
+			sf.kinect_sway = a.num("sway", 0) * kDeg;
+			if (sf.kinect_sway < 0 || sf.kinect_sway > 10 * kDeg) a.fail("sway must be in [0,10] degrees");
 		}
 		else if (kw == "leddar")
 		{

@@ -10,7 +10,9 @@
 //   floor present=1                      # present=0: no floor at all
 //   kinect pose=x,y,z,yaw,pitch,roll     # on the robot; pitch>0 looks down
 //          [noise_scale=1] [min_range=0.5] [max_range=4.5] [spike_prob=1e-4]
-//          [flying_prob=0.5] [grazing_start=70] [grazing_end=85]
+//          [flying_prob=0.5] [grazing_start=70] [grazing_end=85] [sway=0]
+//        # sway: sigma [deg] of a random pitch and roll of the real sensor per
+//        # frame (walker rocking), NOT reflected in the rawlog's sensorPose
 //   leddar pose=x,y,z,yaw,pitch,roll [enabled=1] [sigma=0.025] [max_range=50] [vfov=3]
 //   hole id= shape=rect x= y= sx= sy= [yaw=0] depth=0.06|inf     # centre, sizes
 //   hole id= shape=circle x= y= r= depth=
@@ -65,6 +67,7 @@ struct SceneFile
 	LeddarParams leddar;
 	Pose3 leddar_pose = Pose3::fromXYZYPR(0.20, 0, 0.30, 0, 0, 0);
 	bool leddar_enabled = true;
+	double kinect_sway = 0;	 ///< radians, sigma of the per-frame pitch/roll perturbation
 	PathSpec path;
 	OdometryNoise odometry_noise;
 	GridSpec grid;
