@@ -59,7 +59,9 @@ void loadMapDefinitions(
 struct MapTiming
 {
 	std::string label, className;
-	std::vector<double> totalMs;  ///< per frame
+	std::vector<double> totalMs;  ///< per frame (all frames)
+	std::vector<double> ms3D, ms2D;	 ///< the same, split by frame kind
+	/** Median / 95th percentile over the 3D frames (over all frames if there are none). */
 	double median() const;
 	double p95() const;
 };
