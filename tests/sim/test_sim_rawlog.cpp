@@ -131,3 +131,33 @@ TEST(SimRawlog, BadSceneFileFailsWithFileAndLine)
 	EXPECT_NE(run("--scene " + (d / "missing.scene").string() + " --out " + (d / "x").string(), &err), 0);
 	EXPECT_NE(err.find("cannot open"), std::string::npos) << err;
 }
+
+TEST(SimRawlog, SameSeedSameBytes)
+{
+	const fs::path d = tmpDir();
+	const fs::path scene = d / "seed.scene";
+	{
+		std::ofstream f(scene);
+		f << "kinect pose=0.10,0,1.00,0,25,0\n"
+			 "path waypoints=0,0,0;0.3,0,0 spacing=0.1\n"
+			 "odometry_noise xy=0.02 yaw=1\n"
+			 "box id=1 x=2.5 y=0 sx=0.1 sy=0.1 sz=0.1\n"
+			 "grid resolution=0.05 min_x=-1 max_x=5 min_y=-3 max_y=3\n";
+	}
+	auto slurp = [](const std::string& p) {
+		std::ifstream f(p, std::ios::binary);
+		std::stringstream ss;
+		ss << f.rdbuf();
+		return ss.str();
+	};
+	const std::string a = (d / "a").string(), b = (d / "b").string(), c = (d / "c").string();
+	ASSERT_EQ(run("--scene " + scene.string() + " --out " + a + " --seed 7 --frames 2"), 0);
+	ASSERT_EQ(run("--scene " + scene.string() + " --out " + b + " --seed 7 --frames 2"), 0);
+	ASSERT_EQ(run("--scene " + scene.string() + " --out " + c + " --seed 8 --frames 2"), 0);
+	EXPECT_TRUE(slurp(a + ".rawlog") == slurp(b + ".rawlog"));
+	EXPECT_TRUE(slurp(a + "_gt_path.csv") == slurp(b + "_gt_path.csv"));
+	EXPECT_FALSE(slurp(a + ".rawlog") == slurp(c + ".rawlog"));
+	EXPECT_FALSE(slurp(a + "_gt_path.csv") == slurp(c + "_gt_path.csv"));
+	// without sensor sway the ground truth does not depend on the noise
+	EXPECT_TRUE(slurp(a + "_gt.pgm") == slurp(c + "_gt.pgm"));
+}
