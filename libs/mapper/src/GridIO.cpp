@@ -43,7 +43,7 @@ void writeRosMap(
 	}
 	std::ofstream y(yamlPath);
 	if (!y) throw std::runtime_error("cannot write " + yamlPath);
-	y << std::setprecision(9);
+	y << std::setprecision(7);  // float grid geometry: 0.05, not 0.0500000007
 	y << "image: " << imageName << "\n"
 	  << "mode: scale\n"
 	  << "resolution: " << g.getResolution() << "\n"
