@@ -161,3 +161,51 @@ TEST(SimRawlog, SameSeedSameBytes)
 	// without sensor sway the ground truth does not depend on the noise
 	EXPECT_TRUE(slurp(a + "_gt.pgm") == slurp(c + "_gt.pgm"));
 }
+
+TEST(SimRawlog, TiltedRolledMountUnprojectsOntoTheFloor)
+{
+	// yaw, pitch and roll of the mount all end up in sensorPose the way MRPT reads them
+	const fs::path d = tmpDir();
+	const fs::path scene = d / "tilt.scene";
+	{
+		std::ofstream f(scene);
+		f << "kinect pose=0.05,0.08,0.95,4,30,6\n"
+			 "path waypoints=0,0,0\n"
+			 "box id=1 name=block x=2.25 y=0 sx=0.5 sy=1.0 sz=0.6\n"
+			 "grid resolution=0.05 min_x=-1 max_x=5 min_y=-3 max_y=3\n";
+	}
+	const std::string prefix = (d / "tilt").string();
+	ASSERT_EQ(run("--scene " + scene.string() + " --out " + prefix + " --no-noise --no-leddar"), 0);
+	mrpt::obs::CRawlog rl;
+	ASSERT_TRUE(rl.loadFromRawLogFile(prefix + ".rawlog"));
+	ASSERT_EQ(rl.size(), 2u);
+	auto k = rl.asObservation<mrpt::obs::CObservation3DRangeScan>(1);
+	ASSERT_TRUE(k);
+	EXPECT_NEAR(k->sensorPose.roll(), 6 * M_PI / 180, 1e-9);
+	EXPECT_NEAR(k->sensorPose.yaw(), 4 * M_PI / 180, 1e-9);
+	mrpt::maps::CSimplePointsMap pts;
+	mrpt::obs::T3DPointsProjectionParams pp;
+	pp.takeIntoAccountSensorPoseOnRobot = true;
+	k->unprojectInto(pts, pp);
+	size_t nFloor = 0, nFace = 0;
+	double maxFloorErr = 0, maxFaceErr = 0;
+	for (size_t i = 0; i < pts.size(); i++)
+	{
+		float x, y, z;
+		pts.getPoint(i, x, y, z);
+		if (x < 1.9)
+		{
+			nFloor++;
+			maxFloorErr = std::max(maxFloorErr, double(std::abs(z)));
+		}
+		else if (z > 0.1 && z < 0.5 && std::abs(y) < 0.4)
+		{
+			nFace++;
+			maxFaceErr = std::max(maxFaceErr, std::abs(x - 2.0));
+		}
+	}
+	EXPECT_GT(nFloor, 50000u);
+	EXPECT_GT(nFace, 1000u);
+	EXPECT_LT(maxFloorErr, 0.005);
+	EXPECT_LT(maxFaceErr, 0.002);
+}
