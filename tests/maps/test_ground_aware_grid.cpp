@@ -172,11 +172,19 @@ TEST(GroundAwareGrid, LeddarScanFusesThroughTheBeamModel)
 		s.setScanRange(i, float(2.8 / std::cos(a)));  // wall at x = 3.0 in the robot frame
 		s.setScanRangeValidity(i, true);
 	}
-	CGroundAwareOccupancyGrid g;
+	CGroundAwareOccupancyGrid g, plain;
+	plain.groundOptions.scan_keeps_3d_obstacles = false;
 	ASSERT_TRUE(g.insertObservation(s));
-	EXPECT_GT(pOcc(g, 3.0, 0.0), 0.6);
-	EXPECT_GT(pOcc(g, 3.0, 0.9), 0.6) << "edge segment covered (upsampled beams)";
-	EXPECT_LT(pOcc(g, 1.5, 0.0), 0.4);
+	ASSERT_TRUE(plain.insertObservation(s));
+	for (const auto* m : {&g, &plain})
+	{
+		EXPECT_GT(pOcc(*m, 3.0, 0.0), 0.6);
+		EXPECT_GT(pOcc(*m, 3.0, 0.9), 0.6) << "edge segment covered (upsampled beams)";
+	}
+	// The plain beam model frees the space before the wall; by default a
+	// planar scan does not turn unknown floor into free floor.
+	EXPECT_LT(pOcc(plain, 1.5, 0.0), 0.4);
+	EXPECT_NEAR(pOcc(g, 1.5, 0.0), 0.5, 1e-3);
 }
 
 TEST(GroundAwareGrid, LeddarBeamsOverAHoleDoNotClearIt)

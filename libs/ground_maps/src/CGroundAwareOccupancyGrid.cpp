@@ -106,11 +106,12 @@ gam::ini::Fields CGroundAwareOccupancyGrid::TGroundAwareOptions::fields()
 		{"robot_height", &robot_height, 1e-3, 100, "voxels entirely above this do not block [m]"},
 		{"drop_rays", &drop_rays, 0, 1, "mark cells where rays went below the ground"},
 		{"max_drop_ray_length", &max_drop_ray_length, 0, 100, "longest drop ray [m]"},
+		{"drop_ray_min_points", &drop_ray_min_points, 1, 1000000, "samples a drop voxel needs to cast its ray"},
 		{"local_planes", &local_planes, 0, 1, "use ramp patches near their nodes"},
 		{"plane_support_radius", &plane_support_radius, 0, 100, "reach of a ramp patch around its nodes [m]"},
 		// 2D scans
 		{"sparse_scan_upsampling", &sparse_scan_upsampling, 1, 1000, "rays per beam for scans with < 64 beams"},
-		{"scan_keeps_3d_obstacles", &scan_keeps_3d_obstacles, 0, 1, "2D scans may not free cells that are more likely occupied"}};
+		{"scan_keeps_3d_obstacles", &scan_keeps_3d_obstacles, 0, 1, "2D scans free only cells already free (seen floor)"}};
 }
 
 void CGroundAwareOccupancyGrid::TGroundAwareOptions::loadFromConfigFile(
@@ -183,6 +184,7 @@ gam::IsmParams CGroundAwareOccupancyGrid::TGroundAwareOptions::ismParams() const
 	p.max_range = max_range;
 	p.drop_rays = drop_rays;
 	p.max_drop_ray_length = max_drop_ray_length;
+	p.drop_ray_min_points = drop_ray_min_points;
 	p.local_planes = local_planes;
 	p.plane_support_radius = plane_support_radius;
 	return p;
@@ -270,8 +272,9 @@ bool CGroundAwareOccupancyGrid::insert2D(
 		return COccupancyGridMap2D::internal_insertObservation(use, robotPose);
 
 	// A planar beam sees only its own height: passing over a hole, a cable or
-	// a 5 cm box says nothing about them. So the beam model may add evidence,
-	// but may not make a cell that is now more likely occupied any freer.
+	// a 5 cm box says nothing about the floor. So the beam model adds its hits
+	// and may reinforce cells already known free, but may not make an unknown
+	// or occupied cell any freer: only seen floor is free.
 	const std::vector<cellType> before = m_map;
 	const float x0 = getXMin(), y0 = getYMin();
 	const int sx0 = int(getSizeX()), sy0 = int(getSizeY());
@@ -284,7 +287,7 @@ bool CGroundAwareOccupancyGrid::insert2D(
 		for (int cx = 0; cx < sx0; cx++)
 		{
 			const cellType old = before[size_t(cy) * size_t(sx0) + size_t(cx)];
-			if (old >= 0) continue;	 // free or unknown before: any update is fine
+			if (old > 0) continue;	// free before: any update is fine
 			const int nx = cx + ox, ny = cy + oy;
 			if (nx < 0 || ny < 0 || nx >= sx || ny >= sy) continue;
 			cellType& now = m_map[size_t(ny) * size_t(sx) + size_t(nx)];

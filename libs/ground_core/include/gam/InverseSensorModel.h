@@ -39,6 +39,10 @@ struct IsmParams
 	 * ray crossed the ground plane and the voxel: no floor was there. */
 	bool drop_rays = true;
 	double max_drop_ray_length = 2.0;  ///< [m]
+	/** A drop voxel casts its ray only with at least this many samples: one
+	 * stray return (a depth spike, a reflection metres below the floor) must
+	 * not paint a line of obstacles across the floor. */
+	int drop_ray_min_points = 3;
 	/** Use the tree's extra ground patches (ramps) near their nodes. */
 	bool local_planes = true;
 	/** How far from its nodes a ground patch applies. [m] */

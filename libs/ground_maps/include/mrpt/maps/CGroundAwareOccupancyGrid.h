@@ -85,13 +85,14 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		double robot_height = 1.8;
 		bool drop_rays = true;
 		double max_drop_ray_length = 2.0;
+		int drop_ray_min_points = 3;
 		bool local_planes = true;
 		double plane_support_radius = 0.4;
 		// 2D scans
 		int sparse_scan_upsampling = 8;	 ///< rays per beam for scans of < 64 beams (Leddar)
 		/** A planar beam passes over holes, cables and small boxes: with this
-		 * on, 2D scans add hits and free space but never make a cell that is
-		 * more likely occupied any freer. */
+		 * on, 2D scans add their hits and reinforce cells already free, but
+		 * never make an unknown or occupied cell freer (only seen floor is free). */
 		bool scan_keeps_3d_obstacles = true;
 
 		gam::ini::Fields fields();
