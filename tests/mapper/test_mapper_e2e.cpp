@@ -9,6 +9,7 @@
 #include <mrpt/maps/registerGroundAwareMaps.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CSensoryFrame.h>
@@ -534,4 +535,71 @@ TEST_F(MapperE2E, BadInputsGiveOneLineErrors)
 	// Bad command line.
 	expectError(runMapper("--rawlog '" + obsRawlog + "'"), 2, {"--out"}, "");
 	expectError(runMapper("--no-such-option"), 2, {"no-such-option"}, "");
+}
+
+namespace
+{
+/** 2D-scan-only rawlog: a level 181-ray scanner 0.3 m up sees a wall at x = 2 m. */
+void write2DScanRawlog(const std::string& path)
+{
+	mrpt::io::CFileGZOutputStream f(path);
+	auto ar = mrpt::serialization::archiveFrom(f);
+	for (int k = 0; k < 3; k++)
+	{
+		mrpt::obs::CObservationOdometry odo;
+		odo.odometry = mrpt::poses::CPose2D(0.1 * k, 0, 0);
+		ar << odo;
+		mrpt::obs::CObservation2DRangeScan s;
+		s.sensorLabel = "LIDAR";
+		s.aperture = float(M_PI);
+		s.rightToLeft = true;
+		s.maxRange = 10;
+		s.sensorPose = mrpt::poses::CPose3D(0, 0, 0.3, 0, 0, 0);
+		const size_t N = 181;
+		s.resizeScan(N);
+		for (size_t i = 0; i < N; i++)
+		{
+			const double a = -M_PI / 2 + M_PI * double(i) / double(N - 1);
+			const bool ok = std::abs(a) < mrpt::DEG2RAD(60.0);
+			s.setScanRange(i, ok ? float((2.0 - 0.1 * k) / std::cos(a)) : 0.f);
+			s.setScanRangeValidity(i, ok);
+		}
+		ar << s;
+	}
+}
+}  // namespace
+
+TEST(MapperCli, MapsComeFromTheIniAlone)
+{
+	fs::create_directories(kTmp);
+	const std::string rawlog = kTmp + "/lidar_only.rawlog";
+	write2DScanRawlog(rawlog);
+	const std::string ini = kTmp + "/custom.ini";
+	std::ofstream(ini) << "[map]\n"
+						  "groundAwareGrid_count=1\n"
+						  "occupancyGrid_count=1\n"
+						  "pointsMap_count=1\n"
+						  "[map_occupancyGrid_00_creationOpts]\n"
+						  "label=stock\n"
+						  "min_x=-5\nmax_x=5\nmin_y=-5\nmax_y=5\nresolution=0.05\n";
+	const std::string out = freshDir("out_custom");
+	const auto r = runMapper("--rawlog '" + rawlog + "' --out '" + out + "' --config '" + ini + "' -q");
+	ASSERT_EQ(r.rc, 0) << r.err;
+	EXPECT_NE(r.out.find("frames: 3 (0 3D scans, 3 2D scans)"), std::string::npos) << r.out;
+	for (const std::string n : {"stock", "groundAwareGrid_00"})
+		for (const char* ext : {".yaml", ".pgm", ".gridmap.gz", ".png"})
+			EXPECT_TRUE(fs::exists(out + "/" + n + ext)) << n << ext;
+	EXPECT_TRUE(fs::exists(out + "/pointsMap_00.map.gz"));
+	for (const char* absent : {"ground_aware.yaml", "height_band.yaml", "octomap.yaml", "elevation.png"})
+		EXPECT_FALSE(fs::exists(out + "/" + absent)) << absent;
+	// The wall (x = 2 m in the map frame) is occupied in both grids; the space before it
+	// is free in the stock grid (the ground-aware grid lets 2D scans free only floor its
+	// 3D frames saw, and there are none here).
+	for (const std::string n : {"stock", "groundAwareGrid_00"})
+	{
+		SCOPED_TRACE(n);
+		const auto g = readGridmapGz(out + "/" + n + ".gridmap.gz");
+		EXPECT_LT(minPFree(g, 1.95, 2.1, -0.5, 0.5), 0.3);
+	}
+	EXPECT_GT(pFree(readGridmapGz(out + "/stock.gridmap.gz"), 1.02, 0.03), 0.6);
 }
