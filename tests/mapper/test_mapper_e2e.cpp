@@ -33,7 +33,8 @@ using namespace gam::mapper;
 namespace
 {
 const std::string kExe = GAM_MAPPER_EXE;
-const std::string kTmp = GAM_TEST_TMP_DIR;
+// One work folder per process: ctest may run these tests in parallel.
+const std::string kTmp = std::string(GAM_TEST_TMP_DIR) + "/p" + std::to_string(getpid());
 const std::string kMilk = std::string(GAM_REAL_DATA_DIR) + "/pcl_milk_bottles_on_carpet/pcl_milk_bottles_on_carpet.rawlog";
 const std::vector<std::string> kGrids = {"ground_aware", "height_band", "octomap"};
 
@@ -311,6 +312,17 @@ void checkOutputs(const std::string& dir)
 	for (const auto& de : fs::directory_iterator(dir))
 		EXPECT_NE(de.path().filename().string().rfind(".ground-aware-mapper.tmp", 0), 0u) << de.path();
 }
+
+/** Removes this process's work folder when every test passed. */
+class CleanUp : public ::testing::Environment
+{
+   public:
+	void TearDown() override
+	{
+		if (!::testing::UnitTest::GetInstance()->Failed()) fs::remove_all(kTmp);
+	}
+};
+const auto* const kCleanUp = ::testing::AddGlobalTestEnvironment(new CleanUp);
 
 class MapperE2E : public ::testing::Test
 {
