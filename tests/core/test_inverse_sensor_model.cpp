@@ -423,15 +423,15 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 {
 	const ElevationGrid frame = stepFrame();
 	const GridGeometry& g = frame.geometry();
-	IsmParams p;
+	IsmParams prm;
 	IsmStats st;
 	// By default a drop voxel needs 3 samples to cast a ray: these have one.
-	InverseSensorModel strict(p);
+	InverseSensorModel strict(prm);
 	strict.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
 	EXPECT_EQ(st.drop, 18u * 20u);
 	EXPECT_EQ(st.drop_ray_cells, 0u);
-	p.drop_ray_min_points = 1;
-	InverseSensorModel ism(p);
+	prm.drop_ray_min_points = 1;
+	InverseSensorModel ism(prm);
 	// Sensor 1 m above the plane at the origin: the ray to a voxel at (x, y,
 	// -0.3) crosses z = 0 at 1/1.3 of the way, e.g. x = 2.625 -> 2.019 and
 	// x = 3.475 -> 2.673.
