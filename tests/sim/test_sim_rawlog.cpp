@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -18,9 +19,19 @@ namespace
 {
 fs::path tmpDir()
 {
-	const fs::path d = fs::temp_directory_path() / ("gam_sim_test_" + std::to_string(::getpid()));
-	fs::create_directories(d);
-	return d;
+	// one folder per process, removed when the process ends
+	struct Dir
+	{
+		fs::path p = fs::temp_directory_path() / ("gam_sim_test_" + std::to_string(::getpid()));
+		Dir() { fs::create_directories(p); }
+		~Dir()
+		{
+			std::error_code ec;
+			fs::remove_all(p, ec);
+		}
+	};
+	static Dir d;
+	return d.p;
 }
 
 int run(const std::string& args, std::string* err = nullptr)
