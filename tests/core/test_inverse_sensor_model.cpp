@@ -471,6 +471,7 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 
 	// Limited ray length: only the 0.2 m before each voxel.
 	IsmParams p;
+	p.drop_ray_min_points = 1;
 	p.max_drop_ray_length = 0.2;
 	ism.setParams(p);
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
