@@ -261,7 +261,7 @@ std::string RunSummary::text() const
 {
 	std::ostringstream s;
 	s << "frames: " << frames << " (" << frames3D << " 3D scans, " << frames2D << " 2D scans";
-	if (framesWithoutOdometry) s << ", " << framesWithoutOdometry << " before any odometry";
+	if (framesWithoutOdometry) s << ", " << framesWithoutOdometry << " without odometry: robot at the origin";
 	s << ") in " << std::fixed << std::setprecision(2) << seconds << " s\n";
 	size_t wl = 5, wc = 5;
 	for (const auto& m : maps) wl = std::max(wl, m.label.size()), wc = std::max(wc, m.className.size());
