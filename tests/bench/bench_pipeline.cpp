@@ -1,0 +1,293 @@
+// Per-stage and whole-pipeline timings of the ground-aware grid, and the two
+// comparison maps on the same frames, with Google Benchmark (Release build).
+//
+//   gam-bench [--frames=N] FILE.rawlog [FILE.rawlog ...] [benchmark flags]
+//
+// Each rawlog's 3D frames (up to N, default 20) are loaded once; every case
+// cycles through them. After the cases, a summary prints median and p95 ms
+// per frame of the whole pipeline and of height_band / octomap on the same
+// frames, and the ratios.
+#include <benchmark/benchmark.h>
+#include <mrpt/maps/CGroundAwareOccupancyGrid.h>
+#include <mrpt/maps/CHeightBandOccupancyGrid.h>
+#include <mrpt/maps/COctoMapGrid2D.h>
+#include <mrpt/maps/gam_observation_adapters.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CRawlog.h>
+#include <mrpt/system/filesystem.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+using namespace mrpt::maps;
+using namespace mrpt::obs;
+using mrpt::poses::CPose3D;
+
+namespace
+{
+struct Frame
+{
+	CObservation3DRangeScan::Ptr depth;
+	CObservation2DRangeScan::Ptr scan;	// may be null
+	CPose3D pose;
+};
+struct Dataset
+{
+	std::string name;
+	std::vector<Frame> frames;
+};
+
+Dataset load(const std::string& file, size_t maxFrames)
+{
+	Dataset d;
+	d.name = mrpt::system::extractFileName(file);
+	CRawlog rl;
+	if (!rl.loadFromRawLogFile(file)) throw std::runtime_error("cannot read " + file);
+	CPose3D pose;
+	CObservation2DRangeScan::Ptr lastScan;
+	for (size_t i = 0; i < rl.size() && d.frames.size() < maxFrames; i++)
+	{
+		if (rl.getType(i) != CRawlog::etObservation) continue;
+		auto o = rl.getAsObservation(i);
+		if (auto od = std::dynamic_pointer_cast<CObservationOdometry>(o)) pose = CPose3D(od->odometry);
+		if (auto s2 = std::dynamic_pointer_cast<CObservation2DRangeScan>(o)) lastScan = s2;
+		if (auto s3 = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
+		{
+			s3->load();
+			s3->hasPoints3D = false;  // time the range-image path
+			d.frames.push_back({s3, lastScan, pose});
+		}
+	}
+	// Attach the Leddar scan that follows a depth frame, if it came after it.
+	for (size_t i = 0; i + 1 < d.frames.size(); i++)
+		if (!d.frames[i].scan) d.frames[i].scan = d.frames[i + 1].scan;
+	if (d.frames.empty()) throw std::runtime_error(file + " has no CObservation3DRangeScan");
+	return d;
+}
+
+std::vector<Dataset> g_data;
+
+// --- stage cases -------------------------------------------------------------
+void BM_Projection(benchmark::State& st, const Dataset* d)
+{
+	CGroundAwareOccupancyGrid grid;
+	gam::ElevationGrid frame;
+	gam::GridGeometry geo;
+	geo.nx = grid.groundOptions.m_x;
+	geo.ny = grid.groundOptions.m_y;
+	frame.resize(geo);
+	gam::DepthProjector proj;
+	gam::BinnedPoints bins;
+	gam::mrpt_glue::BinningOptions bo;
+	size_t i = 0;
+	for (auto _ : st)
+	{
+		const Frame& f = d->frames[i++ % d->frames.size()];
+		bo.filter = grid.groundOptions.projectionFilter(f.pose.z());
+		frame.recenter(f.pose.x() - 5, f.pose.y() - 5);
+		bins.clear();
+		gam::mrpt_glue::binObservation(*f.depth, f.pose, bo, frame, proj, bins);
+		benchmark::DoNotOptimize(bins.size());
+	}
+}
+
+void BM_OutlierFilter(benchmark::State& st, const Dataset* d)
+{
+	CGroundAwareOccupancyGrid grid;
+	gam::GridGeometry geo;
+	geo.nx = grid.groundOptions.m_x;
+	geo.ny = grid.groundOptions.m_y;
+	std::vector<std::pair<gam::BinnedPoints, gam::GridGeometry>> pre;
+	gam::ElevationGrid frame(geo);
+	gam::DepthProjector proj;
+	gam::mrpt_glue::BinningOptions bo;
+	for (const Frame& f : d->frames)
+	{
+		gam::BinnedPoints b;
+		bo.filter = grid.groundOptions.projectionFilter(f.pose.z());
+		frame.recenter(f.pose.x() - 5, f.pose.y() - 5);
+		gam::mrpt_glue::binObservation(*f.depth, f.pose, bo, frame, proj, b);
+		pre.emplace_back(std::move(b), frame.geometry());
+	}
+	size_t i = 0;
+	for (auto _ : st)
+	{
+		const auto& [b, g] = pre[i++ % pre.size()];
+		frame.recenter(g.x_min, g.y_min);
+		benchmark::DoNotOptimize(frame.insert(b, grid.groundOptions.outlierParams()));
+	}
+}
+
+// Frames already in 2.5D (projection + filter + IDW done), for RRT-GPD and ISM.
+struct Prepared
+{
+	std::vector<gam::ElevationGrid> grids;
+	std::vector<gam::GroundDetection> dets;
+	std::vector<Eigen::Vector3d> sensors;
+};
+Prepared prepare(const Dataset* d)
+{
+	Prepared p;
+	for (const Frame& f : d->frames)
+	{
+		CGroundAwareOccupancyGrid g;
+		g.insertObservation(*f.depth, f.pose);
+		p.grids.push_back(g.lastFrameElevation());
+		p.dets.push_back(g.lastFrame().detection);
+		p.sensors.push_back(g.lastFrame().sensor);
+	}
+	return p;
+}
+
+void BM_RrtGpd(benchmark::State& st, const Dataset* d)
+{
+	const Prepared p = prepare(d);
+	CGroundAwareOccupancyGrid grid;
+	gam::RrtGroundDetector det(grid.groundOptions.rrtParams());
+	gam::GroundDetection out;
+	size_t i = 0, ok = 0, n = 0;
+	for (auto _ : st)
+	{
+		const size_t k = i++ % p.grids.size();
+		const Frame& f = d->frames[k];
+		det.detect(p.grids[k], {f.pose.x(), f.pose.y(), f.pose.z()}, out);
+		ok += out.ok();
+		n++;
+	}
+	st.counters["ground_found_%"] = n ? 100.0 * double(ok) / double(n) : 0;
+}
+
+void BM_Ism(benchmark::State& st, const Dataset* d)
+{
+	const Prepared p = prepare(d);
+	CGroundAwareOccupancyGrid grid;
+	gam::InverseSensorModel ism(grid.groundOptions.ismParams());
+	gam::IsmStats s;
+	size_t i = 0;
+	for (auto _ : st)
+	{
+		const size_t k = i++ % p.grids.size();
+		ism.compute(p.grids[k], p.dets[k], p.sensors[k], s);
+		benchmark::DoNotOptimize(ism.evidenceCells().size());
+	}
+}
+
+void BM_LeddarInsertion(benchmark::State& st, const Dataset* d)
+{
+	std::vector<const Frame*> withScan;
+	for (const Frame& f : d->frames)
+		if (f.scan) withScan.push_back(&f);
+	if (withScan.empty())
+	{
+		st.SkipWithError("no 2D scans in this rawlog");
+		return;
+	}
+	CGroundAwareOccupancyGrid grid;
+	size_t i = 0;
+	for (auto _ : st)
+	{
+		const Frame* f = withScan[i++ % withScan.size()];
+		grid.insertObservation(*f->scan, f->pose);
+	}
+}
+
+template <class MAP>
+void BM_WholeMap(benchmark::State& st, const Dataset* d)
+{
+	MAP grid;
+	size_t i = 0;
+	for (auto _ : st)
+	{
+		const Frame& f = d->frames[i++ % d->frames.size()];
+		grid.insertObservation(*f.depth, f.pose);
+	}
+}
+
+// --- the summary: same frames, each map, median / p95 -----------------------
+template <class MAP>
+std::vector<double> timesOf(const Dataset& d, int rounds)
+{
+	MAP grid;
+	std::vector<double> ms;
+	for (int r = 0; r < rounds; r++)
+		for (const Frame& f : d.frames)
+		{
+			const auto t0 = std::chrono::steady_clock::now();
+			grid.insertObservation(*f.depth, f.pose);
+			ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+		}
+	return ms;
+}
+double quantile(std::vector<double> v, double q)
+{
+	std::sort(v.begin(), v.end());
+	return v[std::min(v.size() - 1, size_t(q * double(v.size())))];
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+	size_t maxFrames = 20;
+	std::vector<std::string> files;
+	std::vector<char*> bargs{argv[0]};
+	for (int i = 1; i < argc; i++)
+	{
+		if (std::strncmp(argv[i], "--frames=", 9) == 0)
+			maxFrames = size_t(std::max(1, std::atoi(argv[i] + 9)));
+		else if (std::strncmp(argv[i], "--", 2) == 0)
+			bargs.push_back(argv[i]);
+		else
+			files.push_back(argv[i]);
+	}
+	if (files.empty())
+	{
+		std::cerr << "usage: gam-bench [--frames=N] FILE.rawlog [...] [benchmark flags]\n";
+		return 2;
+	}
+	try
+	{
+		for (const auto& f : files) g_data.push_back(load(f, maxFrames));
+	}
+	catch (const std::exception& e)
+	{
+		std::cerr << "gam-bench: error: " << e.what() << "\n";
+		return 1;
+	}
+	for (const Dataset& d : g_data)
+	{
+		const std::string n = d.name + "/";
+		benchmark::RegisterBenchmark((n + "1_projection").c_str(), BM_Projection, &d)->Unit(benchmark::kMillisecond);
+		benchmark::RegisterBenchmark((n + "2_outlier_filter").c_str(), BM_OutlierFilter, &d)->Unit(benchmark::kMillisecond);
+		benchmark::RegisterBenchmark((n + "3_rrt_gpd").c_str(), BM_RrtGpd, &d)->Unit(benchmark::kMillisecond);
+		benchmark::RegisterBenchmark((n + "4_ism").c_str(), BM_Ism, &d)->Unit(benchmark::kMillisecond);
+		benchmark::RegisterBenchmark((n + "5_leddar").c_str(), BM_LeddarInsertion, &d)->Unit(benchmark::kMillisecond);
+		benchmark::RegisterBenchmark((n + "6_whole_pipeline").c_str(), BM_WholeMap<CGroundAwareOccupancyGrid>, &d)
+			->Unit(benchmark::kMillisecond);
+	}
+	int bargc = int(bargs.size());
+	benchmark::Initialize(&bargc, bargs.data());
+	benchmark::RunSpecifiedBenchmarks();
+	benchmark::Shutdown();
+
+	std::printf("\n| data | frames | px/frame | ground_aware median / p95 ms | height_band median / p95 ms | octomap median / p95 ms | height_band / ground_aware | octomap / ground_aware |\n|---|---|---|---|---|---|---|---|\n");
+	for (const Dataset& d : g_data)
+	{
+		const int rounds = std::max(1, int(40 / d.frames.size()));
+		const auto ga = timesOf<CGroundAwareOccupancyGrid>(d, rounds);
+		const auto hb = timesOf<CHeightBandOccupancyGrid>(d, rounds);
+		const auto om = timesOf<COctoMapGrid2D>(d, 1);
+		const double mga = quantile(ga, 0.5), mhb = quantile(hb, 0.5), mom = quantile(om, 0.5);
+		std::printf("| %s | %zu | %zux%zu | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.1fx | %.1fx |\n", d.name.c_str(),
+					d.frames.size(), size_t(d.frames[0].depth->rangeImage.cols()), size_t(d.frames[0].depth->rangeImage.rows()),
+					mga, quantile(ga, 0.95), mhb, quantile(hb, 0.95), mom, quantile(om, 0.95), mhb / mga, mom / mga);
+	}
+	return 0;
+}
