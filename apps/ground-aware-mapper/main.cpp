@@ -105,6 +105,7 @@ int main(int argc, char** argv)
 	try
 	{
 		gam::mapper::Mapper mapper(o);
+		for (const auto& w : mapper.warnings()) std::cerr << kApp << ": warning: " << w << std::endl;
 		const auto s = mapper.run();
 		std::cout << kApp << ": " << s.text() << "outputs: " << s.files.size() << " files in " << o.outDir
 				  << std::endl;

@@ -526,6 +526,13 @@ TEST_F(MapperE2E, BadInputsGiveOneLineErrors)
 			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +
 			withDefaultConfigEdited("band", "\nz_min=0.2 ", "\nz_min=200 ") + "'"),
 		2, {"z_min=200", "out of range"}, out);
+	// A typo in a stock sub-section of one of our maps (never read by its loader).
+	expectError(
+		runMapper(
+			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +
+			withDefaultConfigEdited("stocktypo", "\nmaxOccupancyUpdateCertainty=0.65", "\nmaxOccupancyUpdateCertainy=0.65") +
+			"'"),
+		2, {"maxOccupancyUpdateCertainy", "is not used by"}, out);
 	// Unknown map type.
 	expectError(
 		runMapper(
@@ -593,10 +600,13 @@ TEST(MapperCli, MapsComeFromTheIniAlone)
 						  "pointsMap_count=1\n"
 						  "[map_occupancyGrid_00_creationOpts]\n"
 						  "label=stock\n"
-						  "min_x=-5\nmax_x=5\nmin_y=-5\nmax_y=5\nresolution=0.05\n";
+						  "min_x=-5\nmax_x=5\nmin_y=-5\nmax_y=5\nresolution=0.05\n"
+						  "[map_occupancyGrid_00_insertOpts]\n"
+						  "maxDistanceInsertoin=8\n";  // a typo: stock maps get a warning
 	const std::string out = freshDir("out_custom");
 	const auto r = runMapper("--rawlog '" + rawlog + "' --out '" + out + "' --config '" + ini + "' -q");
 	ASSERT_EQ(r.rc, 0) << r.err;
+	EXPECT_NE(r.err.find("ground-aware-mapper: warning: [map_occupancyGrid_00_insertOpts] key 'maxDistanceInsertoin'"), std::string::npos) << r.err;
 	EXPECT_NE(r.out.find("frames: 3 (0 3D scans, 3 2D scans)"), std::string::npos) << r.out;
 	for (const std::string n : {"stock", "groundAwareGrid_00"})
 		for (const char* ext : {".yaml", ".pgm", ".gridmap.gz", ".png"})

@@ -128,11 +128,51 @@ std::string fmtMs(double v)
 }
 }  // namespace
 
+namespace
+{
+std::string lower(std::string s)
+{
+	std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+	return s;
+}
+
+/** Read-only view of a config that records every (section, key) read. */
+class RecordingConfig : public mrpt::config::CConfigFileBase
+{
+   public:
+	explicit RecordingConfig(const mrpt::config::CConfigFileBase& in) : m_in(in) {}
+	void getAllSections(std::vector<std::string>& s) const override { m_in.getAllSections(s); }
+	void getAllKeys(const std::string& sec, std::vector<std::string>& k) const override { m_in.getAllKeys(sec, k); }
+	void clear() override {}
+	bool wasRead(const std::string& sec, const std::string& key) const
+	{
+		return m_read.count(lower(sec) + "\n" + lower(key)) > 0;
+	}
+
+   protected:
+	void writeString(const std::string&, const std::string&, const std::string&) override
+	{
+		throw std::logic_error("RecordingConfig is read-only");
+	}
+	std::string readString(
+		const std::string& sec, const std::string& name, const std::string& def, bool failIfNotFound) const override
+	{
+		m_read.insert(lower(sec) + "\n" + lower(name));
+		return m_in.read_string(sec, name, def, failIfNotFound);
+	}
+
+   private:
+	const mrpt::config::CConfigFileBase& m_in;
+	mutable std::set<std::string> m_read;
+};
+}  // namespace
+
 // ---------------------------------------------------------------------------
 void loadMapDefinitions(
-	const mrpt::config::CConfigFileBase& ini, const std::string& section,
-	TSetOfMetricMapInitializers& inits, std::vector<MapSpec>& specs)
+	const mrpt::config::CConfigFileBase& iniIn, const std::string& section,
+	TSetOfMetricMapInitializers& inits, std::vector<MapSpec>& specs, std::vector<std::string>* warnings)
 {
+	RecordingConfig ini(iniIn);
 	mrpt::maps::registerGroundAwareMaps();
 	inits.clear();
 	specs.clear();
@@ -227,6 +267,27 @@ void loadMapDefinitions(
 			std::string defLabel = name + "_" + nn;
 			std::replace(defLabel.begin(), defLabel.end(), ':', '_');
 			sp.label = stripComment(ini.read_string(sp.prefix + "_creationOpts", "label", defLabel, false));
+
+			// Keys the map's own loader never read: typos (errors for this project's
+			// maps, warnings for stock MRPT maps, whose loaders may read keys conditionally).
+			{
+				std::vector<std::string> sections;
+				ini.getAllSections(sections);
+				for (const auto& sec : sections)
+				{
+					if (sec.size() <= sp.prefix.size() + 1 || lower(sec.substr(0, sp.prefix.size() + 1)) != lower(sp.prefix + "_"))
+						continue;
+					std::vector<std::string> secKeys;
+					ini.getAllKeys(sec, secKeys);
+					for (const auto& k : secKeys)
+					{
+						if (ini.wasRead(sec, k)) continue;
+						const std::string msg = "[" + sec + "] key '" + k + "' is not used by " + sp.className;
+						if (known.ours) throw ConfigError(msg);
+						if (warnings) warnings->push_back(msg + " (typo?)");
+					}
+				}
+			}
 			if (sp.label.empty()) sp.label = defLabel;
 			if (!validLabel(sp.label))
 				throw ConfigError(
@@ -291,7 +352,7 @@ Mapper::Mapper(const MapperOptions& opts) : m_opts(opts)
 	TSetOfMetricMapInitializers inits;
 	try
 	{
-		loadMapDefinitions(ini, m_opts.section, inits, m_specs);
+		loadMapDefinitions(ini, m_opts.section, inits, m_specs, &m_warnings);
 	}
 	catch (const ConfigError& e)
 	{

@@ -51,10 +51,13 @@ struct MapSpec
 /** Parses and validates the map definitions in `section` (the same order and
  * sections as TSetOfMetricMapInitializers::loadFromConfigFile), rejecting
  * unknown map types, unknown keys / sections of this project's map classes,
- * out-of-range values and bad or duplicate labels. Throws ConfigError. */
+ * out-of-range values and bad or duplicate labels. Throws ConfigError.
+ * Keys in the sections of stock MRPT maps that their loader never read
+ * (typos) are reported in `warnings`. */
 void loadMapDefinitions(
 	const mrpt::config::CConfigFileBase& ini, const std::string& section,
-	mrpt::maps::TSetOfMetricMapInitializers& inits, std::vector<MapSpec>& specs);
+	mrpt::maps::TSetOfMetricMapInitializers& inits, std::vector<MapSpec>& specs,
+	std::vector<std::string>* warnings = nullptr);
 
 struct MapTiming
 {
@@ -87,12 +90,15 @@ class Mapper
 
 	mrpt::maps::CMultiMetricMap& maps() { return m_maps; }
 	const std::vector<MapSpec>& specs() const { return m_specs; }
+	/** Configuration warnings (printed by the app before running). */
+	const std::vector<std::string>& warnings() const { return m_warnings; }
 
    private:
 	void writeMaps(const std::string& tmpDir, RunSummary& s);
 	MapperOptions m_opts;
 	mrpt::maps::CMultiMetricMap m_maps;
 	std::vector<MapSpec> m_specs;
+	std::vector<std::string> m_warnings;
 	mrpt::poses::CPose3D m_lastPose;
 };
 
