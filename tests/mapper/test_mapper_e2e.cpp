@@ -373,6 +373,7 @@ TEST_F(MapperE2E, GeneratedRunsSucceedAndOutputsParse)
 {
 	ASSERT_EQ(obsRun.rc, 0) << obsRun.err;
 	ASSERT_EQ(sfRun.rc, 0) << sfRun.err;
+	EXPECT_EQ(obsRun.err, "");  // nothing on stderr (no progress line when not a tty and short)
 	EXPECT_NE(obsRun.out.find("frames: 4 "), std::string::npos) << obsRun.out;
 	EXPECT_NE(sfRun.out.find("frames: 4 "), std::string::npos) << sfRun.out;
 	checkOutputs(obsOut);
