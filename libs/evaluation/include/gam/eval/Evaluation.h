@@ -1,0 +1,181 @@
+// Ground-aware mapping for MRPT -- map evaluation against simulated ground truth.
+//
+// Scores a 2D occupancy map written in ROS map_server format (yaml + P5 pgm) against
+// the ground truth of gam-simulate: per-object detection by category, floor cells
+// wrongly occupied, floor cells correctly free. Pure C++17, no MRPT.
+//
+// Rules (README "Map evaluator"):
+//  * Every GT cell is compared with the map cells whose centres fall inside it (the
+//    map may have another origin, extent or resolution). The worst one wins, as in
+//    the GT's own probes: occupied if any is occupied, else free if any is free, else
+//    unknown. When no map-cell centre falls inside (coarser map) the map is sampled at
+//    the GT cell centre; outside the map = unknown.
+//  * A map cell is occupied if p_occ > 0.5 + 1/255, free if p_occ < 0.5 - 1/255,
+//    unknown otherwise (grey 127 and 128: the mapper writes 128 for "no evidence").
+//    A second, stricter reading uses the yaml's occupied_thresh / free_thresh (how
+//    map_server and a ROS planner read the map).
+//  * An object counts if it has observed GT obstacle/drop cells; it is detected if at
+//    least `min_hits` of them are occupied in the map. Its coverage = occupied /
+//    observed cells.
+//  * Floor = observed GT cells labelled free (plain floor, ramps, mats) farther than
+//    `tolerance_cells` (Chebyshev) from any GT obstacle/drop cell.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace gam::eval
+{
+/** Every input problem (missing file, bad header, bad value). */
+struct Error : std::runtime_error
+{
+	using std::runtime_error::runtime_error;
+};
+
+/** A ROS map_server map: yaml keys + the image (row 0 = highest y). */
+struct RosMap
+{
+	std::string yamlPath, imagePath, mode = "trinary";
+	double resolution = 0, origin_x = 0, origin_y = 0, origin_yaw = 0;
+	int negate = 0;
+	double occupied_thresh = 0.65, free_thresh = 0.196;
+	int width = 0, height = 0;
+	std::vector<uint8_t> pixels;
+
+	/** p_occupied of cell (col, row from the bottom); mode scale/trinary and negate
+	 * applied (trinary: 1, 0 or 0.5). */
+	double pOcc(int col, int rowFromBottom) const;
+	bool inside(int col, int rowFromBottom) const
+	{
+		return col >= 0 && rowFromBottom >= 0 && col < width && rowFromBottom < height;
+	}
+};
+
+/** Reads the yaml (image, resolution, origin, mode, negate, thresholds) and its P5
+ * pgm (maxval 255; the image path is relative to the yaml's folder). Throws Error. */
+RosMap loadRosMap(const std::string& yamlPath);
+
+enum class Label
+{
+	Free,
+	Obstacle,
+	Drop,
+	Unobserved
+};
+const char* labelName(Label l);
+
+struct GtObject
+{
+	int id = 0;
+	std::string name, type, category;
+};
+
+struct GroundTruth
+{
+	std::string prefix;
+	double resolution = 0;
+	int nx = 0, ny = 0;
+	// per cell, index iy * nx + ix
+	std::vector<double> x, y;  ///< cell centres
+	std::vector<Label> label;
+	std::vector<int> objectId;
+	std::vector<GtObject> objects;
+
+	size_t idx(int ix, int iy) const { return size_t(iy) * size_t(nx) + size_t(ix); }
+	const GtObject* object(int id) const;
+};
+
+/** Reads PREFIX_gt.yaml (resolution), PREFIX_gt_labels.csv and PREFIX_gt_objects.csv.
+ * Throws Error. */
+GroundTruth loadGroundTruth(const std::string& prefix);
+
+enum class CellState : uint8_t
+{
+	Unknown,
+	Free,
+	Occupied
+};
+
+struct Options
+{
+	/** unknown band around p = 0.5 for the main reading (one grey level each side). */
+	double unknown_tolerance = 1.0 / 255.0;
+	/** floor cells closer than this (Chebyshev, cells) to a GT obstacle/drop cell are
+	 * not scored. */
+	int tolerance_cells = 1;
+	/** occupied observed cells an object needs to count as detected. */
+	int min_hits = 1;
+};
+
+/** The map read on the GT grid: per GT cell the highest and lowest p_occ of the map
+ * cells whose centres are inside it (or the map at the GT cell centre); 0.5 outside. */
+struct Resampled
+{
+	std::vector<float> pMax, pMin;
+};
+Resampled resample(const GroundTruth& gt, const RosMap& map);
+
+/** Occupied if pMax > occ, else free if pMin < free, else unknown. */
+std::vector<CellState> classify(const Resampled& r, double occThresh, double freeThresh);
+
+struct ObjectScore
+{
+	int id = 0;
+	std::string name, category;
+	int observed = 0;  ///< observed GT obstacle/drop cells
+	int occupied = 0, free = 0, unknown = 0;
+	bool detected = false;
+	double coverage() const { return observed ? double(occupied) / observed : 0.0; }
+};
+
+struct CategoryScore
+{
+	int objects = 0, detected = 0;
+	double coverageSum = 0;  ///< sum of per-object coverage
+	double detectionRate() const { return objects ? double(detected) / objects : 0.0; }
+	double meanCoverage() const { return objects ? coverageSum / objects : 0.0; }
+};
+
+struct CellCounts
+{
+	long n = 0, occupied = 0, free = 0, unknown = 0;
+	double pct(long v) const { return n ? 100.0 * double(v) / double(n) : 0.0; }
+};
+
+/** Scores of one map with one reading (thresholds). */
+struct Reading
+{
+	std::string name;  ///< "p>0.5" or "map_server"
+	double occ = 0.5, free = 0.5;
+	std::vector<ObjectScore> objects;
+	std::map<std::string, CategoryScore> categories;
+	CellCounts floor;     ///< scored floor cells
+	CellCounts ramp;      ///< the scored floor cells of category ramp
+	CellCounts obstacle;  ///< observed GT obstacle/drop cells
+};
+
+struct MapScore
+{
+	std::string name, yamlPath;
+	Reading main, strict;
+	long excluded_floor = 0;  ///< observed free cells inside the tolerance band
+};
+
+/** Scores `map` against `gt`. */
+MapScore evaluate(const GroundTruth& gt, const RosMap& map, const Options& opt = {});
+
+/** The four categories of the report, in order. */
+const std::vector<std::string>& reportCategories();
+
+/** Human-readable table of several maps. */
+std::string formatTable(const GroundTruth& gt, const std::vector<MapScore>& scores, const Options& opt);
+/** JSON document with every number. */
+std::string toJson(const GroundTruth& gt, const std::vector<MapScore>& scores, const Options& opt);
+/** Flat CSV for aggregation: map,reading,record,id,category,n,occupied,free,unknown,detected
+ * (record = object | floor | ramp | obstacle). */
+std::string toCsv(const std::vector<MapScore>& scores);
+
+}  // namespace gam::eval
