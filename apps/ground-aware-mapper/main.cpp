@@ -6,6 +6,7 @@
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/maps/registerGroundAwareMaps.h>
 
+#include <csignal>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -13,6 +14,9 @@
 namespace
 {
 constexpr const char* kApp = "ground-aware-mapper";
+
+volatile std::sig_atomic_t gStop = 0;
+extern "C" void onSignal(int) { gStop = 1; }
 
 /** Keeps TCLAP's parse error for our one-line message instead of its usage dump. */
 class QuietFailureOutput : public TCLAP::StdOutput
@@ -104,6 +108,9 @@ int main(int argc, char** argv)
 
 	try
 	{
+		o.stopRequested = &gStop;
+		std::signal(SIGINT, onSignal);
+		std::signal(SIGTERM, onSignal);
 		gam::mapper::Mapper mapper(o);
 		for (const auto& w : mapper.warnings()) std::cerr << kApp << ": warning: " << w << std::endl;
 		const auto s = mapper.run();

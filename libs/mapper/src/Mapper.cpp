@@ -420,7 +420,6 @@ RunSummary Mapper::run()
 	fs::remove_all(tmp.path, ec);
 	if (!fs::create_directory(tmp.path, ec))
 		throw RunError("output directory " + m_opts.outDir + " is not writable" + (ec ? ": " + ec.message() : ""));
-	tmp.path = tmp.path;  // cleaned up by ~TmpDir unless kept
 
 	std::ofstream timing(tmp.path + "/timing.csv"), planes(tmp.path + "/ground_planes.csv");
 	if (!timing || !planes) throw RunError("cannot write to " + tmp.path);
@@ -441,96 +440,110 @@ RunSummary Mapper::run()
 
 	// 3. Frames.
 	const bool tty = stderrIsTty();
+	bool progressShown = false;
+	auto clearProgress = [&] {
+		if (progressShown && tty) std::cerr << "\r" << std::string(78, ' ') << "\r" << std::flush;
+		progressShown = false;
+	};
 	auto lastProgress = clk::now();
 	Frame fr;
-	while (true)
+	try
 	{
-		try
+		while (true)
 		{
-			if (!reader->next(fr)) break;
-		}
-		catch (const std::exception& e)
-		{
-			if (m_opts.progress && tty) std::cerr << "\n";
-			throw RunError(e.what());
-		}
-		if (m_opts.maxFrames && fr.index >= m_opts.maxFrames) break;
-		const bool is3D = IS_CLASS(*fr.obs, mrpt::obs::CObservation3DRangeScan);
-		s.frames++;
-		(is3D ? s.frames3D : s.frames2D)++;
-		if (!fr.hasOdometry) s.framesWithoutOdometry++;
-
-		for (size_t i = 0; i < m_specs.size(); i++)
-		{
-			auto& map = *m_maps.maps[i];
-			const auto t0 = clk::now();
+			if (m_opts.stopRequested && *m_opts.stopRequested) throw RunError("interrupted");
 			try
 			{
-				map.insertObservation(*fr.obs, fr.robotPose);
+				if (!reader->next(fr)) break;
 			}
 			catch (const std::exception& e)
 			{
-				throw RunError(
-					"frame " + std::to_string(fr.index) + " (rawlog entry " + std::to_string(fr.entry) + "), map " +
-					m_specs[i].label + ": " + firstLine(e.what()));
+				throw RunError(e.what());
 			}
-			const double ms = std::chrono::duration<double, std::milli>(clk::now() - t0).count();
-			s.maps[i].totalMs.push_back(ms);
-			(is3D ? s.maps[i].ms3D : s.maps[i].ms2D).push_back(ms);
-			const std::string& L = m_specs[i].label;
-			timing << fr.index << "," << L << ",total," << ms << "\n";
-			if (auto* ga = dynamic_cast<CGroundAwareOccupancyGrid*>(&map); ga && is3D && ga->lastFrame().valid)
+			if (m_opts.maxFrames && fr.index >= m_opts.maxFrames) break;
+			const bool is3D = IS_CLASS(*fr.obs, mrpt::obs::CObservation3DRangeScan);
+			s.frames++;
+			(is3D ? s.frames3D : s.frames2D)++;
+			if (!fr.hasOdometry) s.framesWithoutOdometry++;
+
+			for (size_t i = 0; i < m_specs.size(); i++)
 			{
-				const auto& d = ga->lastFrame();
-				timing << fr.index << "," << L << ",projection," << d.ms_projection << "\n"
-					   << fr.index << "," << L << ",outliers," << d.ms_outliers << "\n"
-					   << fr.index << "," << L << ",ground," << d.ms_ground << "\n"
-					   << fr.index << "," << L << ",ism," << d.ms_ism << "\n"
-					   << fr.index << "," << L << ",update," << d.ms_update << "\n";
-				if (int(i) == firstGA)
+				auto& map = *m_maps.maps[i];
+				const auto t0 = clk::now();
+				try
 				{
-					const auto& det = d.detection;
-					planes << fr.index << ",";
-					if (det.ok() && !det.planes.empty())
+					map.insertObservation(*fr.obs, fr.robotPose);
+				}
+				catch (const std::exception& e)
+				{
+					throw RunError(
+						"frame " + std::to_string(fr.index) + " (rawlog entry " + std::to_string(fr.entry) + "), map " +
+						m_specs[i].label + ": " + firstLine(e.what()));
+				}
+				const double ms = std::chrono::duration<double, std::milli>(clk::now() - t0).count();
+				s.maps[i].totalMs.push_back(ms);
+				(is3D ? s.maps[i].ms3D : s.maps[i].ms2D).push_back(ms);
+				const std::string& L = m_specs[i].label;
+				timing << fr.index << "," << L << ",total," << ms << "\n";
+				if (auto* ga = dynamic_cast<CGroundAwareOccupancyGrid*>(&map); ga && is3D && ga->lastFrame().valid)
+				{
+					const auto& d = ga->lastFrame();
+					timing << fr.index << "," << L << ",projection," << d.ms_projection << "\n"
+						   << fr.index << "," << L << ",outliers," << d.ms_outliers << "\n"
+						   << fr.index << "," << L << ",ground," << d.ms_ground << "\n"
+						   << fr.index << "," << L << ",ism," << d.ms_ism << "\n"
+						   << fr.index << "," << L << ",update," << d.ms_update << "\n";
+					if (int(i) == firstGA)
 					{
-						const auto& p = det.plane();
-						planes << p.a << "," << p.b << "," << p.c << "," << p.d;
+						const auto& det = d.detection;
+						planes << fr.index << ",";
+						if (det.ok() && !det.planes.empty())
+						{
+							const auto& p = det.plane();
+							planes << p.a << "," << p.b << "," << p.c << "," << p.d;
+						}
+						else
+							planes << ",,,";
+						planes << "," << det.nodes.size() << ","
+							   << gam::GroundDetection::statusName(det.status) << "\n";
 					}
-					else
-						planes << ",,,";
-					planes << "," << det.nodes.size() << ","
-						   << gam::GroundDetection::statusName(det.status) << "\n";
+				}
+				else if (auto* oc = dynamic_cast<COctoMapGrid2D*>(&map))
+				{
+					timing << fr.index << "," << L << ",octomap_insert," << oc->lastInsertionMs() << "\n"
+						   << fr.index << "," << L << ",projection," << oc->lastProjectionMs() << "\n";
 				}
 			}
-			else if (auto* oc = dynamic_cast<COctoMapGrid2D*>(&map))
-			{
-				timing << fr.index << "," << L << ",octomap_insert," << oc->lastInsertionMs() << "\n"
-					   << fr.index << "," << L << ",projection," << oc->lastProjectionMs() << "\n";
-			}
-		}
 
-		m_lastPose = fr.robotPose;
-		if (m_opts.localMap)
-			for (size_t i = 0; i < m_specs.size(); i++)
-				if (auto* g = dynamic_cast<COccupancyGridMap2D*>(m_maps.maps[i].get()))
-					recentreGrid(*g, fr.robotPose.x(), fr.robotPose.y(), m_opts.localCells);
+			m_lastPose = fr.robotPose;
+			if (m_opts.localMap)
+				for (size_t i = 0; i < m_specs.size(); i++)
+					if (auto* g = dynamic_cast<COccupancyGridMap2D*>(m_maps.maps[i].get()))
+						recentreGrid(*g, fr.robotPose.x(), fr.robotPose.y(), m_opts.localCells);
 
-		if (m_opts.progress)
-		{
-			const auto now = clk::now();
-			const double since = std::chrono::duration<double>(now - lastProgress).count();
-			if (since >= (tty ? 0.5 : 5.0))
+			if (m_opts.progress)
 			{
-				lastProgress = now;
-				const double el = std::chrono::duration<double>(now - tStart).count();
-				std::cerr << (tty ? "\r" : "") << "ground-aware-mapper: frame " << s.frames << ", rawlog entry "
-						  << reader->entriesRead() << ", " << std::fixed << std::setprecision(1)
-						  << (el > 0 ? double(s.frames) / el : 0.0) << " frames/s, " << el << " s"
-						  << (tty ? "   " : "\n") << std::flush;
+				const auto now = clk::now();
+				const double since = std::chrono::duration<double>(now - lastProgress).count();
+				if (since >= (tty ? 0.5 : 5.0))
+				{
+					lastProgress = now;
+					const double el = std::chrono::duration<double>(now - tStart).count();
+					std::cerr << (tty ? "\r" : "") << "ground-aware-mapper: frame " << s.frames << ", rawlog entry "
+							  << reader->entriesRead() << ", " << std::fixed << std::setprecision(1)
+							  << (el > 0 ? double(s.frames) / el : 0.0) << " frames/s, " << el << " s"
+							  << (tty ? "   " : "\n") << std::flush;
+					progressShown = true;
+				}
 			}
 		}
 	}
-	if (m_opts.progress && tty) std::cerr << "\r" << std::string(78, ' ') << "\r" << std::flush;
+	catch (...)
+	{
+		clearProgress();
+		throw;
+	}
+	clearProgress();
 	if (s.frames == 0)
 		throw RunError(
 			"no usable observation in " + m_opts.rawlogPath + " (" + std::to_string(reader->entriesRead()) +

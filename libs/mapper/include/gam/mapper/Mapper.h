@@ -8,6 +8,7 @@
 #include <mrpt/maps/CMultiMetricMap.h>
 #include <mrpt/maps/TMetricMapInitializer.h>
 
+#include <csignal>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -36,6 +37,9 @@ struct MapperOptions
 	int localCells = 600;
 	size_t maxFrames = 0;  ///< 0 = all
 	bool progress = true;
+	/** If set, checked before every frame: non-zero stops the run (RunError
+	 * "interrupted"; nothing is published in outDir). For SIGINT/SIGTERM handlers. */
+	const volatile std::sig_atomic_t* stopRequested = nullptr;
 };
 
 /** One map of the .ini, in CMultiMetricMap order. */
