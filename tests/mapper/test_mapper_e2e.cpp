@@ -369,6 +369,50 @@ TEST(MapperReal, MilkBottlesAllOutputsParseAndMatch)
 	EXPECT_GT(fractionOccupied(g, 0.4, 0.9, -0.4, 0.4), 0.0);
 }
 
+TEST(MapperReal, MilkBottlesSensoryFrameFormatGivesTheSameMaps)
+{
+	if (!fs::exists(kMilk)) GTEST_SKIP() << "missing " << kMilk;
+	// Re-package the observations-only rawlog as CActionCollection (no odometry) + CSensoryFrame.
+	fs::create_directories(kTmp);
+	const std::string sf = kTmp + "/milk_sf.rawlog";
+	{
+		mrpt::io::CFileGZInputStream fi(kMilk);
+		auto in = mrpt::serialization::archiveFrom(fi);
+		mrpt::io::CFileGZOutputStream fo(sf);
+		auto out = mrpt::serialization::archiveFrom(fo);
+		size_t n = 0;
+		try
+		{
+			for (;;)
+			{
+				auto obj = in.ReadObject();
+				auto obs = std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj);
+				if (!obs) continue;
+				mrpt::obs::CActionCollection acts;
+				mrpt::obs::CSensoryFrame frame;
+				frame.insert(obs);
+				out << acts << frame;
+				n++;
+			}
+		}
+		catch (const mrpt::serialization::CExceptionEOF&)
+		{
+		}
+		ASSERT_GT(n, 0u);
+	}
+	const std::string a = freshDir("out_milk_obs"), b = freshDir("out_milk_sf");
+	ASSERT_EQ(runMapper("--rawlog '" + kMilk + "' --out '" + a + "' -q").rc, 0);
+	const auto r = runMapper("--rawlog '" + sf + "' --out '" + b + "' -q");
+	ASSERT_EQ(r.rc, 0) << r.err;
+	for (const auto& n : kGrids)
+	{
+		SCOPED_TRACE(n);
+		EXPECT_TRUE(readGridmapGz(a + "/" + n + ".gridmap.gz").getRawMap() == readGridmapGz(b + "/" + n + ".gridmap.gz").getRawMap());
+		EXPECT_EQ(slurp(a + "/" + n + ".pgm"), slurp(b + "/" + n + ".pgm"));
+	}
+	EXPECT_EQ(slurp(a + "/ground_planes.csv"), slurp(b + "/ground_planes.csv"));
+}
+
 TEST_F(MapperE2E, GeneratedRunsSucceedAndOutputsParse)
 {
 	ASSERT_EQ(obsRun.rc, 0) << obsRun.err;
