@@ -19,6 +19,19 @@ using namespace gam::eval;
 
 namespace
 {
+/** Keeps TCLAP's parse error for a one-line message instead of its usage dump. */
+class QuietFailureOutput : public TCLAP::StdOutput
+{
+   public:
+	std::string error;
+	void failure(TCLAP::CmdLineInterface&, TCLAP::ArgException& e) override
+	{
+		error = e.argId() + ": " + e.error();
+		for (auto& c : error)
+			if (c == '\n' || c == '\r') c = ' ';
+	}
+};
+
 void writeText(const std::string& path, const std::string& text)
 {
 	std::ofstream f(path);
@@ -90,13 +103,12 @@ int main(int argc, char** argv)
 	TCLAP::ValueArg<int> argTol("", "tolerance-cells", "floor cells this close (cells, Chebyshev) to a GT obstacle/drop are not scored (default 1)", false, 1, "N", cmd);
 	TCLAP::ValueArg<int> argHits("", "min-hits", "occupied cells an object needs to be detected (default 1)", false, 1, "N", cmd);
 	TCLAP::SwitchArg argQuiet("q", "quiet", "no table on stdout", cmd);
-	try
+	QuietFailureOutput out;
+	cmd.setOutput(&out);
+	if (!cmd.parse(argc, argv))
 	{
-		cmd.parse(argc, argv);
-	}
-	catch (const TCLAP::ArgException& e)
-	{
-		std::cerr << "gam-evaluate: error: " << e.error() << " (" << e.argId() << ")\n";
+		if (out.error.empty()) return 0;  // --help / --version
+		std::cerr << "gam-evaluate: error: " << out.error << " (see --help)\n";
 		return 2;
 	}
 	Options opt;
