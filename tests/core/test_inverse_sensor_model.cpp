@@ -406,14 +406,16 @@ namespace
 bool isUpper(double x, double y) { return inRect(x, y, 0.5, 1.5, -0.5, 0.5); }
 bool isLower(double x, double y) { return inRect(x, y, 2.6, 3.5, -0.5, 0.5); }
 bool isPatch(double x, double y) { return inRect(x, y, 2.2, 2.3, -0.1, 0.1); }
-ElevationGrid stepFrame()
+ElevationGrid stepFrame(int lowerSamples = 1)
 {
 	ElevationGrid grid;
 	std::mt19937 rng(1);
 	BinnedPoints b;
 	gamtest::sampleSurfaceIf(grid, isUpper, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
 	gamtest::sampleSurfaceIf(grid, isPatch, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
-	gamtest::sampleSurfaceIf(grid, isLower, [](double, double) { return -0.3; }, 1, 0.0, rng, b);
+	// lowerSamples samples per lower cell, at -0.30, -0.31, ...
+	for (int k = 0; k < lowerSamples; k++)
+		gamtest::sampleSurfaceIf(grid, isLower, [k](double, double) { return -0.3 - 0.01 * k; }, 1, 0.0, rng, b);
 	gamtest::insertAll(grid, b);
 	return grid;
 }
@@ -492,6 +494,30 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	EXPECT_NEAR(ism.evidence()[g.index(g.ix(3.0), g.iy(0.0))], pDrop, 1e-6);
 }
 
+TEST(InverseSensorModel, DropRayMinPoints)
+{
+	// Default drop_ray_min_points = 3: lower cells with 3 samples cast rays,
+	// with 2 they are still drops but cast none.
+	const IsmParams p;
+	ASSERT_EQ(p.drop_ray_min_points, 3);
+	InverseSensorModel ism(p);
+	IsmStats st;
+	const ElevationGrid three = stepFrame(3);
+	ism.compute(three, handDetection(kFloor), {0, 0, 1}, st);
+	EXPECT_EQ(st.drop, 18u * 20u);
+	EXPECT_GT(st.drop_ray_cells, 50u);
+	const GridGeometry& g = three.geometry();
+	// Span 0.02 < d_r: rho = 3 / 0.05^3 = 24000 -> P_rho = 1/(1+e^-9).
+	const double p3 = 0.5 + 0.4 / (1 + std::exp(-9.0));
+	EXPECT_NEAR(ism.evidence()[g.index(g.ix(2.4), g.iy(0.0))], p3, 1e-6);
+
+	const ElevationGrid two = stepFrame(2);
+	ism.compute(two, handDetection(kFloor), {0, 0, 1}, st);
+	EXPECT_EQ(st.drop, 18u * 20u);
+	EXPECT_EQ(st.drop_ray_cells, 0u);
+	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.4), g.iy(0.0))], 0.5f);
+}
+
 TEST(InverseSensorModel, NeutralEvidenceIsNeverListed)
 {
 	// K_g = 0 and K_m = 0 (both valid) make every voxel say exactly 0.5:
@@ -501,11 +527,13 @@ TEST(InverseSensorModel, NeutralEvidenceIsNeverListed)
 	IsmParams p;
 	p.K_g = 0;
 	p.K_m = 0;
+	p.drop_ray_min_points = 1;	// the lower cells have one sample: let them cast rays
 	InverseSensorModel ism(p);
 	IsmStats st;
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
 	EXPECT_GT(st.ground, 0u);
 	EXPECT_GT(st.drop, 0u);
+	EXPECT_GT(st.drop_ray_cells, 0u);  // the rays did run (over the gap)
 	EXPECT_TRUE(ism.evidenceCells().empty()) << ism.evidenceCells().size() << " cells listed";
 	checkEvidenceBookkeeping(ism);
 
