@@ -1,0 +1,185 @@
+// Ground-aware mapping for MRPT -- navigation example (library part).
+#include "NavExample.h"
+
+#include <mrpt/img/CImage.h>
+#include <mrpt/nav/planners/PlannerSimple2D.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "gam/sim/Sensors.h"
+
+namespace gam::nav
+{
+namespace
+{
+mrpt::poses::CPose3D toCPose3D(const gam::sim::Pose3& p)
+{
+	const Eigen::Vector3d a = p.ypr();
+	return mrpt::poses::CPose3D(p.t.x(), p.t.y(), p.t.z(), a[0], a[1], a[2]);
+}
+}  // namespace
+
+mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
+	const gam::sim::SceneFile& sf, const gam::sim::Pose2& robot, std::mt19937& rng)
+{
+	const gam::sim::KinectModel kinect(sf.kinect);
+	const gam::sim::Pose3 robot3 =
+		gam::sim::Pose3::fromXYZYPR(robot.x, robot.y, 0, robot.yaw, 0, 0);
+	const gam::sim::DepthFrame fr = kinect.render(sf.scene, robot3 * sf.kinect_pose, rng);
+
+	auto k = mrpt::obs::CObservation3DRangeScan::Create();
+	k->sensorLabel = "KINECT";
+	k->hasRangeImage = true;
+	k->range_is_depth = true;
+	k->rangeUnits = 0.001f;
+	k->maxRange = float(sf.kinect.max_range);
+	k->stdError = float(sf.kinect.sigma(2.0, 0.0));
+	k->sensorPose = toCPose3D(sf.kinect_pose);
+	k->cameraParams.ncols = uint32_t(fr.width);
+	k->cameraParams.nrows = uint32_t(fr.height);
+	k->cameraParams.setIntrinsicParamsFromValues(
+		sf.kinect.fx(), sf.kinect.fy(), sf.kinect.cx(), sf.kinect.cy());
+	k->cameraParamsIntensity = k->cameraParams;
+	k->rangeImage_setSize(fr.height, fr.width);
+	for (int r = 0; r < fr.height; r++)
+		for (int c = 0; c < fr.width; c++)
+		{
+			const float d = fr.depth[fr.idx(r, c)];
+			const long u = d > 0 ? std::lround(d / 0.001) : 0;
+			k->rangeImage(r, c) = uint16_t(std::clamp(u, 0L, 65535L));
+		}
+	return k;
+}
+
+void buildMaps(const gam::sim::SceneFile& sfIn, const MapOptions& opts, NavMaps& out)
+{
+	gam::sim::SceneFile sf = sfIn;
+	sf.kinect.noise = opts.noise;
+	const std::vector<gam::sim::Pose2> poses = gam::sim::samplePath(sf.path);
+	if (poses.empty()) throw std::runtime_error("the scene's path has no frames");
+
+	double x0, x1, y0, y1, res = 0.05;
+	if (sf.has_grid)
+	{
+		x0 = sf.grid.min_x, x1 = sf.grid.max_x, y0 = sf.grid.min_y, y1 = sf.grid.max_y;
+		res = sf.grid.resolution;
+	}
+	else
+	{
+		x0 = x1 = poses[0].x, y0 = y1 = poses[0].y;
+		for (const auto& p : poses)
+		{
+			x0 = std::min(x0, p.x), x1 = std::max(x1, p.x);
+			y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+		}
+		x0 -= 5, x1 += 5, y0 -= 5, y1 += 5;
+	}
+	out.groundAware.setSize(float(x0), float(x1), float(y0), float(y1), float(res), 0.5f);
+	out.heightBand.setSize(float(x0), float(x1), float(y0), float(y1), float(res), 0.5f);
+	out.robotPoses.clear();
+	out.framesWithGround = 0;
+
+	std::mt19937 rng(opts.seed);
+	for (const auto& p : poses)
+	{
+		const auto obs = simulateKinect(sf, p, rng);
+		const mrpt::poses::CPose3D robotPose(p.x, p.y, 0, p.yaw, 0, 0);
+		out.groundAware.insertObservation(*obs, robotPose);
+		out.heightBand.insertObservation(*obs, robotPose);
+		if (out.groundAware.lastFrame().detection.ok()) out.framesWithGround++;
+		out.robotPoses.emplace_back(p.x, p.y, p.yaw);
+	}
+}
+
+PlanResult planPath(
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPoint2D& start,
+	const mrpt::math::TPoint2D& goal, const PlanOptions& opts)
+{
+	mrpt::nav::PlannerSimple2D planner;
+	planner.robotRadius = opts.robotRadius;
+	planner.occupancyThreshold = opts.occupancyThreshold;
+	planner.minStepInReturnedPath = opts.minStepInReturnedPath;
+
+	PlanResult r;
+	bool notFound = true;
+	planner.computePath(
+		grid, mrpt::poses::CPose2D(start.x, start.y, 0), mrpt::poses::CPose2D(goal.x, goal.y, 0),
+		r.path, notFound, opts.maxSearchPathLength);
+	r.found = !notFound && !r.path.empty();
+	if (!r.found) return r;
+
+	const mrpt::math::TPoint2D d = goal - start;
+	const double len = std::hypot(d.x, d.y);
+	for (size_t i = 0; i < r.path.size(); i++)
+	{
+		if (i > 0) r.length += (r.path[i] - r.path[i - 1]).norm();
+		if (len > 0)
+		{
+			const mrpt::math::TPoint2D v = r.path[i] - start;
+			r.maxDeviation = std::max(r.maxDeviation, std::abs(d.x * v.y - d.y * v.x) / len);
+		}
+	}
+	return r;
+}
+
+mrpt::maps::CSimplePointsMap obstaclePointsRobotFrame(
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::poses::CPose2D& robotPose,
+	const ObstacleOptions& opts)
+{
+	mrpt::maps::CSimplePointsMap pts;
+	const double r2 = opts.maxRange * opts.maxRange;
+	for (unsigned cy = 0; cy < grid.getSizeY(); cy++)
+		for (unsigned cx = 0; cx < grid.getSizeX(); cx++)
+		{
+			if (grid.getCell(int(cx), int(cy)) >= opts.maxFreeProbability) continue;
+			const double x = grid.idx2x(cx), y = grid.idx2y(cy);
+			const double dx = x - robotPose.x(), dy = y - robotPose.y();
+			if (dx * dx + dy * dy > r2) continue;
+			double lx, ly;
+			robotPose.inverseComposePoint(x, y, lx, ly);
+			pts.insertPoint(float(lx), float(ly), opts.z);
+		}
+	return pts;
+}
+
+double distanceToHoles(const gam::sim::Scene& scene, double x, double y, double step)
+{
+	double best = std::numeric_limits<double>::infinity();
+	for (const auto& h : scene.holes)
+	{
+		if (h.containsXY(x, y)) return 0;
+		const double R = h.shape == gam::sim::Hole::Circle ? h.r : std::hypot(h.hx, h.hy);
+		for (double sx = h.cx - R; sx <= h.cx + R; sx += step)
+			for (double sy = h.cy - R; sy <= h.cy + R; sy += step)
+				if (h.containsXY(sx, sy)) best = std::min(best, std::hypot(sx - x, sy - y));
+	}
+	return best;
+}
+
+void savePathPicture(
+	const mrpt::maps::COccupancyGridMap2D& grid, const PlanResult& plan,
+	const mrpt::math::TPoint2D& start, const mrpt::math::TPoint2D& goal, const std::string& file,
+	int scale)
+{
+	const int W = int(grid.getSizeX()), H = int(grid.getSizeY());
+	mrpt::img::CImage img(W * scale, H * scale, mrpt::img::CH_RGB);
+	auto cellRect = [&](int cx, int cy, const mrpt::img::TColor& c) {
+		const int px = cx * scale, py = (H - 1 - cy) * scale;  // +y up
+		img.filledRectangle(px, py, px + scale - 1, py + scale - 1, c);
+	};
+	for (int cy = 0; cy < H; cy++)
+		for (int cx = 0; cx < W; cx++)
+		{
+			const uint8_t g = uint8_t(std::lround(255.0 * grid.getCell(cx, cy)));
+			cellRect(cx, cy, mrpt::img::TColor(g, g, g));
+		}
+	for (const auto& p : plan.path) cellRect(grid.x2idx(p.x), grid.y2idx(p.y), {255, 0, 0});
+	cellRect(grid.x2idx(start.x), grid.y2idx(start.y), {0, 200, 0});
+	cellRect(grid.x2idx(goal.x), grid.y2idx(goal.y), {0, 0, 255});
+	if (!img.saveToFile(file)) throw std::runtime_error("cannot write " + file);
+}
+
+}  // namespace gam::nav

@@ -1,0 +1,108 @@
+// Ground-aware mapping for MRPT -- navigation example (library part).
+//
+// Maps a simulated scene (libs/ground_sim) with CGroundAwareOccupancyGrid and
+// with the height-band baseline CHeightBandOccupancyGrid, plans on each grid
+// with mrpt::nav::PlannerSimple2D, and exports the occupied cells of a grid as
+// the robot-frame obstacle points MRPT's reactive navigator consumes
+// (CRobot2NavInterface::senseObstacles() fills a CSimplePointsMap of obstacles
+// in the robot frame; CReactiveNavigationSystem keeps the points whose z is in
+// [min_obstacles_height, max_obstacles_height]).
+//
+// Used by apps/ground-aware-nav-example and tests/nav.
+#pragma once
+
+#include <mrpt/maps/CGroundAwareOccupancyGrid.h>
+#include <mrpt/maps/CHeightBandOccupancyGrid.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/math/TPoint2D.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/poses/CPose2D.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <deque>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "gam/sim/SceneFile.h"
+
+namespace gam::nav
+{
+/** The depth frame a simulated Kinect takes at a robot pose, as the
+ * CObservation3DRangeScan gam-simulate writes (range image in mm, depth along
+ * +X, the scene's sensor pose and intrinsics). `sensorNoise` false = exact. */
+mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
+	const gam::sim::SceneFile& sf, const gam::sim::Pose2& robot, std::mt19937& rng);
+
+/** The two grids of one mapping run over the scene's path. */
+struct NavMaps
+{
+	mrpt::maps::CGroundAwareOccupancyGrid groundAware;
+	mrpt::maps::CHeightBandOccupancyGrid heightBand;
+	std::vector<mrpt::poses::CPose2D> robotPoses;  ///< one per frame (true poses)
+	size_t framesWithGround = 0;  ///< frames where RRT-GPD found the floor
+};
+
+struct MapOptions
+{
+	bool noise = true;	///< simulate sensor noise (the scene's Kinect model)
+	unsigned seed = 1;
+};
+
+/** Renders every frame of the scene's path with the Kinect model and inserts
+ * it into both grids (extent = the scene's `grid` line, or the path +- 5 m).
+ * Both grids keep their default options (paper Table I, band 0.2-1.5 m). */
+void buildMaps(const gam::sim::SceneFile& sf, const MapOptions& opts, NavMaps& out);
+
+struct PlanOptions
+{
+	float robotRadius = 0.30f;	///< PlannerSimple2D::robotRadius [m]
+	/** PlannerSimple2D::occupancyThreshold: cells whose FREE probability is
+	 * below it are obstacles (unknown cells, 0.5, are traversable). */
+	float occupancyThreshold = 0.45f;
+	float minStepInReturnedPath = 0.05f;  ///< dense path, one point per cell
+	float maxSearchPathLength = -1;
+};
+
+struct PlanResult
+{
+	bool found = false;
+	std::deque<mrpt::math::TPoint2D> path;	///< map frame, start to goal
+	double length = 0;	///< [m]
+	/** Largest |y - straight line| of the path from start to goal [m]. */
+	double maxDeviation = 0;
+};
+
+PlanResult planPath(
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPoint2D& start,
+	const mrpt::math::TPoint2D& goal, const PlanOptions& opts = {});
+
+struct ObstacleOptions
+{
+	/** A cell is an obstacle if its FREE probability is below this. */
+	float maxFreeProbability = 0.4f;
+	double maxRange = 6.0;	///< only cells within this distance of the robot [m]
+	/** z of every point. The grid is 2D; any z inside the reactive navigator's
+	 * [min_obstacles_height, max_obstacles_height] works (defaults 0..10). */
+	float z = 0.1f;
+};
+
+/** The occupied cells of `grid` (cell centres) within maxRange of the robot,
+ * in the ROBOT frame (p_robot = robotPose (-) p_map), as the CSimplePointsMap
+ * CRobot2NavInterface::senseObstacles() returns to CReactiveNavigationSystem. */
+mrpt::maps::CSimplePointsMap obstaclePointsRobotFrame(
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::poses::CPose2D& robotPose,
+	const ObstacleOptions& opts = {});
+
+/** Smallest distance [m] from a point to the union of the scene's holes
+ * (0 inside one), sampled on a grid of `step` metres inside each hole. */
+double distanceToHoles(const gam::sim::Scene& scene, double x, double y, double step = 0.01);
+
+/** Writes a PNG picture of the grid with the path drawn over it (red) and the
+ * start (green) and goal (blue), one pixel per cell scaled by `scale`. */
+void savePathPicture(
+	const mrpt::maps::COccupancyGridMap2D& grid, const PlanResult& plan,
+	const mrpt::math::TPoint2D& start, const mrpt::math::TPoint2D& goal, const std::string& file,
+	int scale = 4);
+
+}  // namespace gam::nav
