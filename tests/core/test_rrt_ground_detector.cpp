@@ -65,6 +65,7 @@ TEST(RrtGpdParams, ValidateRejectsOutOfRangeValues)
 		{"s_x=0", [](RrtGpdParams& p) { p.neighbourhood_x = 0; }},
 		{"s_x=33", [](RrtGpdParams& p) { p.neighbourhood_x = 33; }},
 		{"s_x*s_y=1", [](RrtGpdParams& p) { p.neighbourhood_x = p.neighbourhood_y = 1; p.min_valid_cells = 3; }},
+		{"s_x=1 (collinear)", [](RrtGpdParams& p) { p.neighbourhood_x = 1; p.neighbourhood_y = 5; p.min_valid_cells = 3; }},
 		{"d_n=0", [](RrtGpdParams& p) { p.expansion_distance = 0; }},
 		{"max_cell_std=0", [](RrtGpdParams& p) { p.max_cell_std = 0; }},
 		{"max_fit_rms<0", [](RrtGpdParams& p) { p.max_fit_rms = -1; }},

@@ -565,7 +565,7 @@ TEST_F(MapperE2E, BadInputsGiveOneLineErrors)
 		runMapper(
 			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +
 			withDefaultConfigEdited("range", "\nK=600", "\nK=0") + "'"),
-		2, {"K=0", "out of range", "[1, 1e+06]"}, out);
+		2, {"K=0", "out of range", "1 to 1e+06"}, out);
 	expectError(
 		runMapper(
 			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +

@@ -84,6 +84,15 @@ outlier_filter=false
 	EXPECT_EQ(mm.countMapsByClass<COccupancyGridMap2D>(), 2u);
 }
 
+TEST(IniConstruction, LeddarNoReturnIsNotFreeSpaceFromIniEither)
+{
+	CMultiMetricMap mm(initsFrom("[map]\ngroundAwareGrid_count=1\n"));
+	EXPECT_FALSE(mm.mapByClass<CGroundAwareOccupancyGrid>()->insertionOptions.considerInvalidRangesAsFreeSpace);
+	CMultiMetricMap explicitOn(initsFrom(
+		"[map]\ngroundAwareGrid_count=1\n[map_groundAwareGrid_00_insertOpts]\nconsiderInvalidRangesAsFreeSpace=true\n"));
+	EXPECT_TRUE(explicitOn.mapByClass<CGroundAwareOccupancyGrid>()->insertionOptions.considerInvalidRangesAsFreeSpace);
+}
+
 TEST(IniConstruction, DefaultsAreThePaperTableI)
 {
 	CGroundAwareOccupancyGrid g;
@@ -135,7 +144,7 @@ TEST(IniConstruction, OutOfRangeValuesNameTheKey)
 		std::string section, key, value;
 	};
 	const std::vector<Case> bad = {
-		{"groundOpts", "K", "0"},		  {"groundOpts", "s_x", "4"},	   {"groundOpts", "N_th", "1.5"},
+		{"groundOpts", "K", "0"},		  {"groundOpts", "s_x", "4"},	  {"groundOpts", "s_y", "1"},	   {"groundOpts", "N_th", "1.5"},
 		{"groundOpts", "d_pth", "-0.1"},  {"groundOpts", "K_m", "1.2"},	   {"groundOpts", "m_x", "0"},
 		{"groundOpts", "E_th", "abc"},	  {"groundOpts", "drop_rays", "maybe"},
 		{"creationOpts", "resolution", "-0.05"}};

@@ -45,9 +45,9 @@ void RrtGpdParams::validate() const
 	require(iterations >= 1 && iterations <= 1000000, "K (iterations)", "in [1, 1000000]", iterations);
 	require(normal_threshold > 0 && normal_threshold <= 1, "N_th (normal_threshold)", "in (0, 1]", normal_threshold);
 	require(elevation_threshold > 0 && elevation_threshold < 10, "E_th (elevation_threshold)", "in (0, 10) m", elevation_threshold);
-	require(neighbourhood_x >= 1 && neighbourhood_x <= 31 && neighbourhood_x % 2 == 1, "s_x (neighbourhood_x)", "odd, in [1, 31]", neighbourhood_x);
-	require(neighbourhood_y >= 1 && neighbourhood_y <= 31 && neighbourhood_y % 2 == 1, "s_y (neighbourhood_y)", "odd, in [1, 31]", neighbourhood_y);
-	require(neighbourhood_x * neighbourhood_y >= 3, "s_x*s_y", ">= 3 cells", neighbourhood_x * neighbourhood_y);
+	// A plane needs a 2D neighbourhood: 1 x N cells are collinear.
+	require(neighbourhood_x >= 3 && neighbourhood_x <= 31 && neighbourhood_x % 2 == 1, "s_x (neighbourhood_x)", "odd, in [3, 31]", neighbourhood_x);
+	require(neighbourhood_y >= 3 && neighbourhood_y <= 31 && neighbourhood_y % 2 == 1, "s_y (neighbourhood_y)", "odd, in [3, 31]", neighbourhood_y);
 	require(expansion_distance > 0 && expansion_distance < 100, "d_n (expansion_distance)", "in (0, 100) m", expansion_distance);
 	require(max_cell_std > 0, "max_cell_std", "> 0 m", max_cell_std);
 	require(max_fit_rms > 0, "max_fit_rms", "> 0 m", max_fit_rms);
@@ -128,7 +128,9 @@ bool RrtGroundDetector::findSeed(
 	const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed)
 {
 	const GridGeometry& g = grid.geometry();
-	const int R = std::max(1, int(std::ceil(m_params.seed_search_radius / g.resolution)));
+	// No seed can lie farther than the grid reaches: cap the offset table.
+	const int R = std::max(
+		1, int(std::min<double>(std::ceil(m_params.seed_search_radius / g.resolution), std::max(g.nx, g.ny))));
 	if (R != m_ringRadius)
 	{
 		// Cell offsets within the radius, nearest first.

@@ -17,7 +17,12 @@ MAP_DEFINITION_REGISTER(
 	"mrpt::maps::CGroundAwareOccupancyGrid,groundAwareGrid", mrpt::maps::CGroundAwareOccupancyGrid)
 IMPLEMENTS_SERIALIZABLE(CGroundAwareOccupancyGrid, COccupancyGridMap2D, mrpt::maps)
 
-CGroundAwareOccupancyGrid::TMapDefinition::TMapDefinition() = default;
+CGroundAwareOccupancyGrid::TMapDefinition::TMapDefinition()
+{
+	// As the constructor: a Leddar "no return" is not free space (an .ini
+	// key in _insertOpts still overrides it).
+	insertionOpts.considerInvalidRangesAsFreeSpace = false;
+}
 
 void CGroundAwareOccupancyGrid::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
@@ -77,8 +82,8 @@ gam::ini::Fields CGroundAwareOccupancyGrid::TGroundAwareOptions::fields()
 		{"K", &K, 1, 1000000, "RRT-GPD iterations"},
 		{"N_th", &N_th, 1e-6, 1, "max horizontal part of a node's unit normal (sin of tilt)"},
 		{"E_th", &E_th, 1e-6, 10, "max height step from the parent's local plane [m]"},
-		{"s_x", &s_x, 1, 31, "local fit neighbourhood along x [cells, odd]"},
-		{"s_y", &s_y, 1, 31, "local fit neighbourhood along y [cells, odd]"},
+		{"s_x", &s_x, 3, 31, "local fit neighbourhood along x [cells, odd]"},
+		{"s_y", &s_y, 3, 31, "local fit neighbourhood along y [cells, odd]"},
 		{"d_n", &d_n, 1e-3, 100, "node expansion distance [m]"},
 		{"max_cell_std", &max_cell_std, 1e-6, 10, "cells rougher than this are not surfaces [m]"},
 		{"max_fit_rms", &max_fit_rms, 1e-6, 10, "local fits with a larger RMS are not planar [m]"},

@@ -28,8 +28,10 @@ void check(const Field& fl, const std::string& context, const std::string& raw)
 	if (!std::isfinite(v) || v < fl.lo || v > fl.hi)
 	{
 		std::ostringstream s;
-		s << context << " " << fl.key << "=" << (raw.empty() ? fmt(v) : raw) << " is out of range ["
-		  << fmt(fl.lo) << ", " << fmt(fl.hi) << "]";
+		// No square brackets: MRPT's exception wrapper (MRPT_END) parses them
+		// and would split this message across its Location and Message lines.
+		s << context << " " << fl.key << "=" << (raw.empty() ? fmt(v) : raw) << " is out of range "
+		  << fmt(fl.lo) << " to " << fmt(fl.hi);
 		if (!fl.help.empty()) s << " (" << fl.help << ")";
 		throw std::invalid_argument(s.str());
 	}
@@ -139,7 +141,7 @@ std::string describe(const Fields& fields)
 					s << *p;
 			},
 			fl.var);
-		s << "\t; [" << fmt(fl.lo) << ", " << fmt(fl.hi) << "] " << fl.help << "\n";
+		s << "\t; " << fmt(fl.lo) << " to " << fmt(fl.hi) << ": " << fl.help << "\n";
 	}
 	return s.str();
 }

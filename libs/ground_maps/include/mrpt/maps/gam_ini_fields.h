@@ -24,7 +24,8 @@ using Fields = std::vector<Field>;
 
 /** Reads every field present in `section` (absent keys keep their value) and
  * checks its range. Throws std::invalid_argument:
- * "[section] key=value is out of range [lo, hi] (meaning)" or "... is not a number". */
+ * "in section 'S': key=value is out of range lo to hi (meaning)" or "... is not a
+ * number" (no square brackets: MRPT's exception wrapper would split the message). */
 void load(const Fields& f, const mrpt::config::CConfigFileBase& src, const std::string& section);
 void save(const Fields& f, mrpt::config::CConfigFileBase& dst, const std::string& section);
 /** Range check of the current values; `context` prefixes the message. */
