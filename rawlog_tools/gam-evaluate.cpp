@@ -46,20 +46,22 @@ void writePng(
 	const std::vector<MapScore>& scores)
 {
 	using mrpt::img::TColor;
-	const int k = std::clamp(360 / std::max(1, std::max(gt.nx, gt.ny)), 1, 8);
-	const int pw = gt.nx * k, ph = gt.ny * k, gap = 8, top = 36, foot = 6;
+	const int k = int(std::clamp(std::lround(480.0 / std::max(1, std::max(gt.nx, gt.ny))), 1L, 8L));
+	const int pw = gt.nx * k, ph = gt.ny * k, gap = 8, top = 20, label = 16;
 	const int n = 1 + int(maps.size());
-	mrpt::img::CImage im(n * pw + (n + 1) * gap, ph + top + foot, mrpt::img::CH_RGB);
+	const int cols = (n * (pw + gap) > 1600 && n > 2) ? (n + 1) / 2 : n, rows = (n + cols - 1) / cols;
+	mrpt::img::CImage im(cols * pw + (cols + 1) * gap, top + rows * (ph + label + gap), mrpt::img::CH_RGB);
 	im.filledRectangle(0, 0, int(im.getWidth()) - 1, int(im.getHeight()) - 1, TColor(255, 255, 255));
 	const TColor unknown(190, 205, 235);
 	auto panel = [&](int p, const std::string& name, auto colourOf) {
-		const int x0 = gap + p * (pw + gap);
-		im.textOut(x0, 19, name, TColor(0, 0, 0));
+		const int x0 = gap + (p % cols) * (pw + gap), yb = top + (p / cols) * (label + ph + gap);
+		im.textOut(x0, yb, name, TColor(0, 0, 0));
+		const int y0 = yb + label;
 		for (int iy = 0; iy < gt.ny; iy++)
 			for (int ix = 0; ix < gt.nx; ix++)
 			{
 				const TColor c = colourOf(gt.idx(ix, iy));
-				const int px = x0 + ix * k, py = top + (gt.ny - 1 - iy) * k;
+				const int px = x0 + ix * k, py = y0 + (gt.ny - 1 - iy) * k;
 				im.filledRectangle(px, py, px + k - 1, py + k - 1, c);
 			}
 	};
