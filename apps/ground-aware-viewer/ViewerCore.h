@@ -1,0 +1,149 @@
+// Ground-aware mapping for MRPT -- ground-aware-viewer, the GUI-free part.
+//
+// ViewerModel: a rawlog's frames grouped into steps (each 3D scan with the 2D
+// scans before it), the three grids (ground-aware, height-band, octomap) fed
+// step by step, the ground-aware options (editable: a change re-runs the
+// current step from a snapshot of the grid taken before it).
+// ViewerScene: what to draw for each view (point cloud, 2.5D voxels, ground
+// plane patch, RRT tree, grids as textured planes) as mrpt::opengl scenes,
+// and off-screen rendering to PNG with CFBORender (no display needed).
+// Used by the wx GUI (ViewerApp.cpp), its batch mode and tests/viewer.
+#pragma once
+
+#include <mrpt/maps/CGroundAwareOccupancyGrid.h>
+#include <mrpt/maps/CHeightBandOccupancyGrid.h>
+#include <mrpt/maps/COctoMapGrid2D.h>
+#include <mrpt/math/TPoint3D.h>
+#include <mrpt/obs/CObservation.h>
+#include <mrpt/opengl/CCamera.h>
+#include <mrpt/opengl/COpenGLScene.h>
+#include <mrpt/poses/CPoint3D.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace gam::viewer
+{
+/** One step of the viewer: the 2D scans since the previous 3D scan, then the
+ * 3D scan (the last observation; a rawlog without 3D scans has one step per
+ * 2D scan). */
+struct Step
+{
+	std::vector<mrpt::obs::CObservation::Ptr> obs;
+	std::vector<mrpt::poses::CPose3D> poses;  ///< robot pose of each observation
+	bool has3D = false;
+	size_t index3D = 0;	 ///< position of the 3D scan in obs (when has3D)
+	size_t firstFrame = 0;	///< frame index (as ground-aware-mapper counts) of obs[0]
+};
+
+/** Per-step timings [ms] of each map's insertObservation(). */
+struct StepTiming
+{
+	double groundAware = 0, heightBand = 0, octomap = 0;
+};
+
+class ViewerModel
+{
+   public:
+	ViewerModel();
+
+	/** Reads the whole rawlog (either format; see gam::mapper::RawlogFrameReader).
+	 * Throws std::runtime_error. Resets the maps. */
+	void openRawlog(const std::string& path);
+	/** Maps from an .ini in ground-aware-mapper's format (section `section`):
+	 * the first map of each of the three classes is used; missing ones get
+	 * the class defaults. Empty path = class defaults. Throws on a bad .ini.
+	 * Resets the maps (re-runs up to the current step). */
+	void loadConfig(const std::string& iniPath, const std::string& section = "map");
+
+	size_t stepCount() const { return m_steps.size(); }
+	const Step& step(size_t i) const { return m_steps.at(i); }
+	/** Index of the step whose result is shown, -1 before the first. */
+	int current() const { return m_current; }
+	/** Processes steps until `k` is the current one (forward incrementally,
+	 * backward by re-running from the start). */
+	void seek(int k);
+	bool next();  ///< false at the end
+	void prev() { seek(m_current - 1); }
+	/** Restores the ground-aware grid as it was before the current step and
+	 * inserts the step again (with the current groundOptions). */
+	void rerunCurrent();
+
+	/** The ground-aware options; after editing them call applyGroundOptions(). */
+	mrpt::maps::CGroundAwareOccupancyGrid::TGroundAwareOptions& groundOptions()
+	{
+		return m_ga->groundOptions;
+	}
+	/** Validates (throws std::invalid_argument, options unchanged then) and re-runs the current step. */
+	void applyGroundOptions(const mrpt::maps::CGroundAwareOccupancyGrid::TGroundAwareOptions& o);
+
+	const mrpt::maps::CGroundAwareOccupancyGrid& groundAware() const { return *m_ga; }
+	const mrpt::maps::CHeightBandOccupancyGrid& heightBand() const { return *m_hb; }
+	const mrpt::maps::COctoMapGrid2D& octomap() const { return *m_oc; }
+
+	/** Robot pose at the current step (its last observation). */
+	mrpt::poses::CPose3D currentPose() const;
+	/** Robot path up to the current step. */
+	std::vector<mrpt::poses::CPose3D> pathSoFar() const;
+	/** Map-frame points of the current step's 3D scan (decimated), empty if none. */
+	const std::vector<mrpt::math::TPoint3Df>& framePoints() const { return m_points; }
+	const StepTiming& timing() const { return m_timing; }
+	/** Multi-line text: step, frame, detection status, voxel classes, stage timings. */
+	std::string statusText() const;
+	std::string rawlogPath() const { return m_rawlog; }
+
+   private:
+	void resetMaps();
+	void insertStep(size_t k);
+	void updatePoints();
+
+	std::string m_rawlog;
+	std::vector<Step> m_steps;
+	int m_current = -1;
+	std::shared_ptr<mrpt::maps::CGroundAwareOccupancyGrid> m_ga, m_gaTemplate, m_gaBefore;
+	std::shared_ptr<mrpt::maps::CHeightBandOccupancyGrid> m_hb, m_hbTemplate;
+	std::shared_ptr<mrpt::maps::COctoMapGrid2D> m_oc, m_ocTemplate;
+	std::vector<mrpt::math::TPoint3Df> m_points;
+	StepTiming m_timing;
+};
+
+enum class View
+{
+	Frame3D,  ///< current step: point cloud, 2.5D voxels by class, ground plane, RRT tree
+	Map3D,	///< accumulated ground-aware grid, path, current point cloud
+	Grids,	///< the three grids side by side (top view)
+	GridGroundAware,  ///< one grid, top view
+	GridHeightBand,
+	GridOctomap
+};
+const char* viewName(View v);  ///< file stem: frame, map, grids, grid_ground_aware, ...
+std::vector<View> allViews();
+
+/** The xy box the grid views show: the observed part of the ground-aware grid
+ * plus a margin (or the robot +- 3 m before anything is observed). */
+struct Box
+{
+	double x0 = -3, x1 = 3, y0 = -3, y1 = 3;
+	double w() const { return x1 - x0; }
+	double h() const { return y1 - y0; }
+};
+Box gridViewBox(const ViewerModel& m);
+
+class ViewerScene
+{
+   public:
+	/** Fills `scene` (cleared first) and sets `cam` for the view; `aspect` =
+	 * image width / height (for the top views' zoom). */
+	static void build(
+		const ViewerModel& m, View v, mrpt::opengl::COpenGLScene& scene, mrpt::opengl::CCamera& cam,
+		double aspect);
+	/** Pixel (column, row from the top) of world point (x, y) in a W x H
+	 * rendering of a single-grid top view. */
+	static void gridPixel(const ViewerModel& m, double x, double y, int W, int H, double& col, double& row);
+	/** Renders with CFBORender (off-screen, EGL: no display needed) into a PNG. */
+	static void renderToPng(const ViewerModel& m, View v, const std::string& file, int W = 800, int H = 600);
+};
+
+}  // namespace gam::viewer

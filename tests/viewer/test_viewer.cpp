@@ -1,0 +1,218 @@
+// ground-aware-viewer: the batch mode (--screenshot-dir DIR --exit, CFBORender,
+// no display) on a small simulated rawlog (nav_hole.scene: a 0.6 m floor
+// hatch between two walls), and the GUI-free model/scene classes.
+#include <gtest/gtest.h>
+#include <mrpt/img/CImage.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "ViewerCore.h"
+
+namespace fs = std::filesystem;
+using gam::viewer::View;
+using gam::viewer::ViewerModel;
+using gam::viewer::ViewerScene;
+
+namespace
+{
+const std::string kTmp = std::string(GAM_TEST_TMP_DIR) + "/p" + std::to_string(getpid());
+
+int run(const std::string& cmd, std::string* out = nullptr)
+{
+	FILE* p = popen((cmd + " 2>&1").c_str(), "r");
+	if (!p) return -1;
+	std::string s;
+	char buf[4096];
+	while (size_t n = fread(buf, 1, sizeof(buf), p)) s.append(buf, n);
+	const int st = pclose(p);
+	if (out) *out = s;
+	return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+struct Stats
+{
+	double mean = 0, variance = 0;
+};
+/** Grey-level mean and variance of a W x H block centred on (c, r). */
+Stats blockStats(const mrpt::img::CImage& img, double c, double r, int half)
+{
+	Stats s;
+	size_t n = 0;
+	for (int y = int(r) - half; y <= int(r) + half; y++)
+		for (int x = int(c) - half; x <= int(c) + half; x++)
+		{
+			if (x < 0 || y < 0 || x >= int(img.getWidth()) || y >= int(img.getHeight())) continue;
+			const double v = img.getAsFloat(x, y) * 255.0;
+			s.mean += v;
+			s.variance += v * v;
+			n++;
+		}
+	if (n)
+	{
+		s.mean /= double(n);
+		s.variance = s.variance / double(n) - s.mean * s.mean;
+	}
+	return s;
+}
+Stats imageStats(const mrpt::img::CImage& img)
+{
+	return blockStats(img, img.getWidth() / 2, img.getHeight() / 2, int(std::max(img.getWidth(), img.getHeight())));
+}
+
+class Viewer : public ::testing::Test
+{
+   protected:
+	static void SetUpTestSuite()
+	{
+		fs::create_directories(kTmp);
+		rawlog = kTmp + "/nav.rawlog";
+		std::string out;
+		ASSERT_EQ(run(std::string(GAM_SIMULATE_EXE) + " --scene " + GAM_SOURCE_DIR +
+						  "/config/scenes/nav_hole.scene --out " + kTmp + "/nav --no-leddar",
+					  &out),
+				  0)
+			<< out;
+		shots = kTmp + "/shots";
+		batchRc = run(std::string(GAM_VIEWER_EXE) + " " + rawlog + " --screenshot-dir " + shots +
+						  " --frame 10 --exit --width 640 --height 480",
+					  &batchOut);
+		model = std::make_unique<ViewerModel>();
+		model->openRawlog(rawlog);
+		model->seek(10);
+	}
+	static void TearDownTestSuite()
+	{
+		model.reset();
+		if (!::testing::UnitTest::GetInstance()->failed_test_count()) fs::remove_all(kTmp);
+	}
+	static mrpt::img::CImage load(const std::string& stem)
+	{
+		mrpt::img::CImage img;
+		EXPECT_TRUE(img.loadFromFile(shots + "/" + stem + ".png")) << stem;
+		return img;
+	}
+	static std::string rawlog, shots, batchOut;
+	static int batchRc;
+	static std::unique_ptr<ViewerModel> model;
+};
+std::string Viewer::rawlog, Viewer::shots, Viewer::batchOut;
+int Viewer::batchRc = -1;
+std::unique_ptr<ViewerModel> Viewer::model;
+}  // namespace
+
+TEST_F(Viewer, BatchModeWritesEveryViewWithoutADisplay)
+{
+	ASSERT_EQ(batchRc, 0) << batchOut;
+	EXPECT_NE(batchOut.find("step 11 / 11"), std::string::npos) << batchOut;
+	EXPECT_NE(batchOut.find("stages [ms]: projection"), std::string::npos) << batchOut;
+	for (View v : gam::viewer::allViews())
+	{
+		const auto img = load(gam::viewer::viewName(v));
+		ASSERT_EQ(img.getWidth(), 640u) << gam::viewer::viewName(v);
+		ASSERT_EQ(img.getHeight(), 480u);
+		const Stats s = imageStats(img);
+		EXPECT_GT(s.variance, 200.0) << gam::viewer::viewName(v) << " looks blank";
+	}
+	std::ifstream t(shots + "/timings.txt");
+	std::stringstream ss;
+	ss << t.rdbuf();
+	EXPECT_NE(ss.str().find("ground: ok"), std::string::npos) << ss.str();
+}
+
+TEST_F(Viewer, HoleIsDarkInTheGroundAwareViewOnly)
+{
+	ASSERT_EQ(batchRc, 0) << batchOut;
+	const auto ga = load("grid_ground_aware"), hb = load("grid_height_band");
+	double c, r;
+	// the hatch: 0.6 x 0.6 m at (2.5, 0)
+	ViewerScene::gridPixel(*model, 2.5, 0.0, 640, 480, c, r);
+	const Stats gaHole = blockStats(ga, c, r, 4), hbHole = blockStats(hb, c, r, 4);
+	EXPECT_LT(gaHole.mean, 60.0) << "hole not dark in the ground-aware view at " << c << "," << r;
+	EXPECT_GT(hbHole.mean, 180.0) << "hole dark in the height-band view";
+	// seen floor beside it: bright in both
+	ViewerScene::gridPixel(*model, 2.5, 0.9, 640, 480, c, r);
+	EXPECT_GT(blockStats(ga, c, r, 3).mean, 200.0);
+	EXPECT_GT(blockStats(hb, c, r, 3).mean, 200.0);
+	// the left wall (y = 1.45..1.55): a dark row in both, somewhere in y 1.3..1.7
+	for (const auto* img : {&ga, &hb})
+	{
+		double darkest = 255;
+		for (double y = 1.3; y <= 1.7; y += 0.01)
+		{
+			ViewerScene::gridPixel(*model, 2.5, y, 640, 480, c, r);
+			darkest = std::min(darkest, blockStats(*img, c, r, 0).mean);
+		}
+		EXPECT_LT(darkest, 100.0) << (img == &ga ? "ground-aware" : "height-band") << " wall";
+	}
+}
+
+TEST_F(Viewer, ModelMatchesTheBatchRun)
+{
+	EXPECT_EQ(model->stepCount(), 11u);
+	EXPECT_EQ(model->current(), 10);
+	EXPECT_TRUE(model->groundAware().lastFrame().detection.ok());
+	EXPECT_EQ(model->framePoints().empty(), false);
+	// the hatch cell is occupied in the ground-aware grid, not in the height band
+	const auto& ga = model->groundAware();
+	const auto& hb = model->heightBand();
+	EXPECT_LT(ga.getPos(2.5, 0.0), 0.3f);
+	EXPECT_GE(hb.getPos(2.5, 0.0), 0.5f);
+}
+
+TEST_F(Viewer, ParameterChangeRerunsTheCurrentFrame)
+{
+	ViewerModel m;
+	m.openRawlog(rawlog);
+	m.seek(5);
+	const size_t nodes = m.groundAware().lastFrame().detection.nodes.size();
+	ASSERT_GT(nodes, 20u);
+	auto o = m.groundOptions();
+	o.K = 20;  // far fewer RRT iterations
+	m.applyGroundOptions(o);
+	EXPECT_EQ(m.current(), 5);
+	EXPECT_LT(m.groundAware().lastFrame().detection.nodes.size(), nodes);
+	EXPECT_EQ(m.groundOptions().K, 20);
+	// back to the default: the same tree as before (the step is re-run from the snapshot)
+	o.K = 600;
+	m.applyGroundOptions(o);
+	EXPECT_EQ(m.groundAware().lastFrame().detection.nodes.size(), nodes);
+	// invalid: rejected, options unchanged
+	o.N_th = -1;
+	EXPECT_THROW(m.applyGroundOptions(o), std::invalid_argument);
+	EXPECT_DOUBLE_EQ(m.groundOptions().N_th, 0.2);
+	// stepping keeps the edited options; going back re-runs from the start with them
+	o = m.groundOptions();
+	o.drop_rays = false;
+	m.applyGroundOptions(o);
+	m.seek(2);
+	EXPECT_FALSE(m.groundOptions().drop_rays);
+	EXPECT_EQ(m.current(), 2);
+}
+
+TEST_F(Viewer, ScenesHaveTheExpectedObjects)
+{
+	mrpt::opengl::COpenGLScene scene;
+	mrpt::opengl::CCamera cam;
+	ViewerScene::build(*model, View::Frame3D, scene, cam, 4.0 / 3.0);
+	// point cloud, voxels, ground plane patch, tree edges + nodes, robot, path, floor grid
+	size_t n = 0;
+	for (const auto& o : *scene.getViewport()) n += o != nullptr;
+	EXPECT_GE(n, 7u);
+	ViewerScene::build(*model, View::Grids, scene, cam, 4.0 / 3.0);
+	EXPECT_EQ(scene.getViewport()->size(), 3u);
+	EXPECT_TRUE(cam.isOrthogonal());
+}
+
+TEST_F(Viewer, BadArgumentsFail)
+{
+	std::string out;
+	EXPECT_EQ(run(std::string(GAM_VIEWER_EXE) + " --exit --screenshot-dir " + kTmp + "/x", &out), 2) << out;
+	EXPECT_EQ(run(std::string(GAM_VIEWER_EXE) + " " + kTmp + "/missing.rawlog --exit --screenshot-dir " + kTmp + "/x", &out), 1) << out;
+	EXPECT_NE(out.find("ground-aware-viewer: error:"), std::string::npos) << out;
+}
