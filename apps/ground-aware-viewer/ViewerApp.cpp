@@ -42,6 +42,7 @@ struct Args
 	int frame = -1;	 ///< -1 = the last one
 	bool exit = false;
 	int width = 800, height = 600;
+	std::string guiSnapshot;  ///< (self-check) capture the GUI window into this PNG and quit
 };
 
 /** Renders every view into dir/<view>.png (+ timings.txt). */
@@ -206,6 +207,35 @@ class ViewerFrame : public wxFrame
 		}
 		fillProperties();
 		CallAfter([this] { refreshAll(true); });
+		if (!a.guiSnapshot.empty())
+		{
+			// self-check: exercise a parameter edit, then grab the window (X server pixels)
+			m_snapTimer.Bind(wxEVT_TIMER, [this](wxTimerEvent&) {
+				if (m_snapStage++ == 0)
+				{
+					if (auto* p = m_props->GetPropertyByName("K"))
+					{
+						m_props->ChangePropertyValue(p, wxVariant(long(100)));
+						std::cout << "gui: K=100 applied, " << m_model.groundAware().lastFrame().detection.nodes.size()
+								  << " RRT nodes" << std::endl;
+					}
+					m_snapTimer.StartOnce(1500);
+					return;
+				}
+				wxWindowDC dc(this);
+				const wxSize sz = GetSize();
+				wxBitmap bmp(sz.x, sz.y);
+				wxMemoryDC mem(bmp);
+				wxScreenDC screen;
+				const wxPoint pos = GetScreenPosition();
+				mem.Blit(0, 0, sz.x, sz.y, &screen, pos.x, pos.y);
+				mem.SelectObject(wxNullBitmap);
+				const bool ok = bmp.SaveFile(m_args.guiSnapshot, wxBITMAP_TYPE_PNG);
+				std::cout << "gui: snapshot " << (ok ? "written" : "FAILED") << " " << m_args.guiSnapshot << std::endl;
+				Close(true);
+			});
+			m_snapTimer.StartOnce(3000);
+		}
 	}
 
    private:
@@ -367,6 +397,8 @@ class ViewerFrame : public wxFrame
 	wxButton* m_play = nullptr;
 	wxCheckBox* m_follow = nullptr;
 	wxTimer m_timer;
+	wxTimer m_snapTimer;
+	int m_snapStage = 0;
 };
 
 Args g_args;
@@ -376,6 +408,7 @@ class ViewerApp : public wxApp
    public:
 	bool OnInit() override	// no wxApp::OnInit(): our own command line
 	{
+		wxInitAllImageHandlers();
 		auto* f = new ViewerFrame(g_args);
 		f->Show();
 		return true;
@@ -400,6 +433,7 @@ int main(int argc, char** argv)
 		TCLAP::SwitchArg argExit("", "exit", "batch mode: render the screenshots and exit", cmd);
 		TCLAP::ValueArg<int> argW("", "width", "screenshot width [px]", false, 800, "W", cmd);
 		TCLAP::ValueArg<int> argH("", "height", "screenshot height [px]", false, 600, "H", cmd);
+		TCLAP::ValueArg<std::string> argGuiShot("", "gui-snapshot", "(self-check) open the GUI, edit K, save the window to FILE.png and quit", false, "", "FILE", cmd);
 		cmd.parse(argc, argv);
 		Args a;
 		a.rawlog = argRawlog.isSet() ? argRawlog.getValue() : argFile.getValue();
@@ -410,6 +444,7 @@ int main(int argc, char** argv)
 		a.exit = argExit.getValue();
 		a.width = argW.getValue();
 		a.height = argH.getValue();
+		a.guiSnapshot = argGuiShot.getValue();
 		if (a.exit)
 		{
 			if (a.rawlog.empty() || a.shotDir.empty())

@@ -582,7 +582,7 @@ void ViewerScene::build(
 			cam.setPointingAt(float(0.5 * (box.x0 + box.x1)), float(0.5 * (box.y0 + box.y1)), 0.f);
 			cam.setAzimuthDegrees(-90.f);
 			cam.setElevationDegrees(55.f);
-			cam.setZoomDistance(float(std::max(box.w(), box.h()) * 1.4));
+			cam.setZoomDistance(float(std::max(box.w(), box.h()) * 1.4 * std::max(1.0, 1.33 / aspect)));
 			break;
 		}
 		case View::Grids:

@@ -216,3 +216,20 @@ TEST_F(Viewer, BadArgumentsFail)
 	EXPECT_EQ(run(std::string(GAM_VIEWER_EXE) + " " + kTmp + "/missing.rawlog --exit --screenshot-dir " + kTmp + "/x", &out), 1) << out;
 	EXPECT_NE(out.find("ground-aware-viewer: error:"), std::string::npos) << out;
 }
+
+TEST_F(Viewer, GuiStartsEditsAParameterAndDrawsUnderXvfb)
+{
+	if (run("command -v xvfb-run") != 0) GTEST_SKIP() << "xvfb-run not installed";
+	const std::string png = kTmp + "/gui.png";
+	std::string out;
+	const int rc = run("xvfb-run -a -s '-screen 0 1400x900x24' " + std::string(GAM_VIEWER_EXE) + " " +
+						   rawlog + " --frame 5 --gui-snapshot " + png,
+					   &out);
+	ASSERT_EQ(rc, 0) << out;
+	EXPECT_NE(out.find("gui: K=100 applied"), std::string::npos) << out;
+	EXPECT_NE(out.find("gui: snapshot written"), std::string::npos) << out;
+	mrpt::img::CImage img;
+	ASSERT_TRUE(img.loadFromFile(png));
+	EXPECT_GT(img.getWidth(), 800u);
+	EXPECT_GT(imageStats(img).variance, 200.0);
+}
