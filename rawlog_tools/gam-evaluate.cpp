@@ -10,6 +10,7 @@
 #include <mrpt/img/CImage.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -130,6 +131,17 @@ int main(int argc, char** argv)
 		{
 			maps.push_back(loadRosMap(y));
 			scores.push_back(evaluate(gt, maps.back(), opt));
+		}
+		// two maps with the same file name (e.g. two runs' ground_aware.yaml): name them
+		// by their folder too
+		for (auto& a : scores)
+		{
+			bool dup = false;
+			for (const auto& b : scores) dup |= (&a != &b && a.name == b.name);
+			if (!dup) continue;
+			const auto p = std::filesystem::path(a.yamlPath);
+			const std::string parent = p.parent_path().filename().string();
+			if (!parent.empty()) a.name = parent + "/" + a.name;
 		}
 		if (!argQuiet.getValue()) std::cout << formatTable(gt, scores, opt);
 		if (!argJson.getValue().empty()) writeText(argJson.getValue(), toJson(gt, scores, opt));

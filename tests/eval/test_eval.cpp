@@ -1,6 +1,7 @@
 // Tests of libs/evaluation (gam::eval) and rawlog_tools/gam-evaluate on hand-made
 // ground truth and hand-made maps written into a temporary folder.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -420,6 +421,13 @@ TEST(EvalCli, WritesJsonCsvPngAndFailsCleanly)
 			  0);
 	EXPECT_NE(slurp(d / "o.json").find("\"name\": \"octomap\""), std::string::npos);
 	EXPECT_NE(slurp(d / "o.csv").find("ground_aware,main,floor"), std::string::npos);
+	// the same map file name from two folders: told apart by the folder
+	fs::create_directories(d / "runB");
+	fs::copy_file(d / "ground_aware.yaml", d / "runB/ground_aware.yaml");
+	fs::copy_file(d / "ground_aware.pgm", d / "runB/ground_aware.pgm");
+	const std::string m3 = d / "runB/ground_aware.yaml";
+	EXPECT_EQ(run("--gt " + prefix + " --map " + m1 + " --map " + m3 + " --json " + (d / "dup.json"), err), 0);
+	EXPECT_NE(slurp(d / "dup.json").find("\"name\": \"runB/ground_aware\""), std::string::npos);
 	EXPECT_GT(fs::file_size(d / "o.png"), 100u);
 	// missing ground truth: exit 1, one line
 	EXPECT_EQ(run("--gt " + (d / "nope") + " --map " + m1, err), 1);
