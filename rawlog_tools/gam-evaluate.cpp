@@ -134,14 +134,13 @@ int main(int argc, char** argv)
 		}
 		// two maps with the same file name (e.g. two runs' ground_aware.yaml): name them
 		// by their folder too
-		for (auto& a : scores)
+		std::vector<bool> dup(scores.size(), false);
+		for (size_t i = 0; i < scores.size(); i++)
+			for (size_t j = 0; j < scores.size(); j++) dup[i] = dup[i] || (i != j && scores[i].name == scores[j].name);
+		for (size_t i = 0; i < scores.size(); i++)
 		{
-			bool dup = false;
-			for (const auto& b : scores) dup |= (&a != &b && a.name == b.name);
-			if (!dup) continue;
-			const auto p = std::filesystem::path(a.yamlPath);
-			const std::string parent = p.parent_path().filename().string();
-			if (!parent.empty()) a.name = parent + "/" + a.name;
+			const std::string parent = std::filesystem::path(scores[i].yamlPath).parent_path().filename().string();
+			if (dup[i] && !parent.empty()) scores[i].name = parent + "/" + scores[i].name;
 		}
 		if (!argQuiet.getValue()) std::cout << formatTable(gt, scores, opt);
 		if (!argJson.getValue().empty()) writeText(argJson.getValue(), toJson(gt, scores, opt));
