@@ -158,7 +158,7 @@ class ViewerFrame : public wxFrame
 			m_canvases.push_back(c);
 		};
 		addCanvas(row1, View::Frame3D, "Current frame: point cloud, 2.5D voxels (green ground, red obstacle, magenta drop), ground plane, RRT tree", 1);
-		addCanvas(row1, View::Map3D, "Accumulated ground-aware map", 1);
+		addCanvas(row1, View::Map3D, "Accumulated: 2.5D map, point cloud, ground-aware grid below", 1);
 		vs->Add(row1, 3, wxEXPAND);
 		auto* row2 = new wxBoxSizer(wxHORIZONTAL);
 		addCanvas(row2, View::Grids, "Grids: ground-aware | height-band | octomap (white free, black occupied, blue unknown)", 3);

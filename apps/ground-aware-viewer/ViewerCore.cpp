@@ -11,6 +11,7 @@
 #include <mrpt/opengl/CGridPlaneXY.h>
 #include <mrpt/opengl/CPointCloud.h>
 #include <mrpt/opengl/CPointCloudColoured.h>
+#include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/opengl/CSetOfLines.h>
 #include <mrpt/opengl/CSetOfTriangles.h>
 #include <mrpt/opengl/CTexturedPlane.h>
@@ -57,7 +58,7 @@ ViewerModel::ViewerModel() { loadConfig(""); }
 
 void ViewerModel::loadConfig(const std::string& iniPath, const std::string& section)
 {
-	std::shared_ptr<mrpt::maps::TMetricMapInitializer> defGA, defHB, defOC;
+	std::shared_ptr<mrpt::maps::TMetricMapInitializer> defGA, defHB, defOC, defEL;
 	if (!iniPath.empty())
 	{
 		if (!std::filesystem::exists(iniPath)) throw std::runtime_error("cannot read " + iniPath);
@@ -71,11 +72,20 @@ void ViewerModel::loadConfig(const std::string& iniPath, const std::string& sect
 			if (!defGA && cls == "mrpt::maps::CGroundAwareOccupancyGrid") defGA = d;
 			if (!defHB && cls == "mrpt::maps::CHeightBandOccupancyGrid") defHB = d;
 			if (!defOC && cls == "mrpt::maps::COctoMapGrid2D") defOC = d;
+			if (!defEL && cls == "mrpt::maps::CElevation25DMap") defEL = d;
 		}
 	}
 	if (!defGA) defGA = std::make_shared<CGroundAwareOccupancyGrid::TMapDefinition>();
 	if (!defHB) defHB = std::make_shared<CHeightBandOccupancyGrid::TMapDefinition>();
 	if (!defOC) defOC = std::make_shared<COctoMapGrid2D::TMapDefinition>();
+	if (!defEL)
+	{
+		auto d = std::make_shared<mrpt::maps::CElevation25DMap::TMapDefinition>();
+		d->min_x = d->min_y = -10;
+		d->max_x = d->max_y = 10;
+		defEL = d;
+	}
+	m_elTemplate = create<mrpt::maps::CElevation25DMap>(*defEL);
 	m_gaTemplate = create<CGroundAwareOccupancyGrid>(*defGA);
 	m_hbTemplate = create<CHeightBandOccupancyGrid>(*defHB);
 	m_ocTemplate = create<COctoMapGrid2D>(*defOC);
@@ -90,8 +100,10 @@ void ViewerModel::resetMaps()
 	m_gaBefore = std::make_shared<CGroundAwareOccupancyGrid>(*m_gaTemplate);
 	m_hb = std::make_shared<CHeightBandOccupancyGrid>(*m_hbTemplate);
 	m_oc = std::make_shared<COctoMapGrid2D>(*m_ocTemplate);
+	m_el = std::make_shared<mrpt::maps::CElevation25DMap>(*m_elTemplate);
 	m_current = -1;
 	m_points.clear();
+	m_mapPoints.clear();
 	m_timing = {};
 }
 
@@ -156,9 +168,14 @@ void ViewerModel::insertStep(size_t k)
 		t0 = std::chrono::steady_clock::now();
 		m_oc->insertObservation(*s.obs[i], s.poses[i]);
 		m_timing.octomap += msSince(t0);
+		t0 = std::chrono::steady_clock::now();
+		m_el->insertObservation(*s.obs[i], s.poses[i]);
+		m_timing.elevation += msSince(t0);
 	}
 	m_current = int(k);
 	updatePoints();
+	// every 8th point of the frame into the accumulated cloud
+	for (size_t i = 0; i < m_points.size(); i += 8) m_mapPoints.push_back(m_points[i]);
 }
 
 void ViewerModel::seek(int k)
@@ -289,7 +306,8 @@ std::string ViewerModel::statusText() const
 	else
 		o << "(no 3D scan in this step)\n";
 	o << "insert [ms]: ground_aware " << m_timing.groundAware << ", height_band "
-	  << m_timing.heightBand << ", octomap " << m_timing.octomap << "\n";
+	  << m_timing.heightBand << ", octomap " << m_timing.octomap << ", elevation "
+	  << m_timing.elevation << "\n";
 	return o.str();
 }
 
@@ -573,8 +591,19 @@ void ViewerScene::build(
 		case View::Map3D:
 		{
 			vp->setCustomBackgroundColor({0.12f, 0.12f, 0.15f});
-			scene.insert(gridTexture(m.groundAware(), box, res, 0));
-			auto pc = cloudOf(m.framePoints());
+			// the 2.5D map's columns, with the ground-aware grid underneath them
+			float zlo = 0, zhi = 0;
+			const bool hasEl = m.elevation().getMinMaxHeight(zlo, zhi);
+			auto tex = gridTexture(m.groundAware(), box, res, 0);
+			tex->setLocation(0, 0, std::min(0.f, hasEl ? zlo : 0.f) - 0.05);
+			scene.insert(tex);
+			if (hasEl)
+			{
+				auto el = CSetOfObjects::Create();
+				m.elevation().getVisualizationInto(*el);
+				scene.insert(el);
+			}
+			auto pc = cloudOf(m.mapPoints());
 			pc->setPointSize(1.f);
 			scene.insert(pc);
 			addRobotAndPath(m, scene);

@@ -10,6 +10,7 @@
 // Used by the wx GUI (ViewerApp.cpp), its batch mode and tests/viewer.
 #pragma once
 
+#include <mrpt/maps/CElevation25DMap.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
 #include <mrpt/maps/COctoMapGrid2D.h>
@@ -41,7 +42,7 @@ struct Step
 /** Per-step timings [ms] of each map's insertObservation(). */
 struct StepTiming
 {
-	double groundAware = 0, heightBand = 0, octomap = 0;
+	double groundAware = 0, heightBand = 0, octomap = 0, elevation = 0;
 };
 
 class ViewerModel
@@ -53,8 +54,9 @@ class ViewerModel
 	 * Throws std::runtime_error. Resets the maps. */
 	void openRawlog(const std::string& path);
 	/** Maps from an .ini in ground-aware-mapper's format (section `section`):
-	 * the first map of each of the three classes is used; missing ones get
-	 * the class defaults. Empty path = class defaults. Throws on a bad .ini.
+	 * the first map of each of the three grid classes and the first
+	 * CElevation25DMap are used; missing ones get the class defaults (the
+	 * elevation map then covers +-10 m). Empty path = class defaults. Throws on a bad .ini.
 	 * Resets the maps (re-runs up to the current step). */
 	void loadConfig(const std::string& iniPath, const std::string& section = "map");
 
@@ -82,6 +84,10 @@ class ViewerModel
 	const mrpt::maps::CGroundAwareOccupancyGrid& groundAware() const { return *m_ga; }
 	const mrpt::maps::CHeightBandOccupancyGrid& heightBand() const { return *m_hb; }
 	const mrpt::maps::COctoMapGrid2D& octomap() const { return *m_oc; }
+	/** The accumulated 2.5D map (CElevation25DMap). */
+	const mrpt::maps::CElevation25DMap& elevation() const { return *m_el; }
+	/** Map-frame points of every 3D scan up to the current step (decimated more). */
+	const std::vector<mrpt::math::TPoint3Df>& mapPoints() const { return m_mapPoints; }
 
 	/** Robot pose at the current step (its last observation). */
 	mrpt::poses::CPose3D currentPose() const;
@@ -105,14 +111,15 @@ class ViewerModel
 	std::shared_ptr<mrpt::maps::CGroundAwareOccupancyGrid> m_ga, m_gaTemplate, m_gaBefore;
 	std::shared_ptr<mrpt::maps::CHeightBandOccupancyGrid> m_hb, m_hbTemplate;
 	std::shared_ptr<mrpt::maps::COctoMapGrid2D> m_oc, m_ocTemplate;
-	std::vector<mrpt::math::TPoint3Df> m_points;
+	std::shared_ptr<mrpt::maps::CElevation25DMap> m_el, m_elTemplate;
+	std::vector<mrpt::math::TPoint3Df> m_points, m_mapPoints;
 	StepTiming m_timing;
 };
 
 enum class View
 {
 	Frame3D,  ///< current step: point cloud, 2.5D voxels by class, ground plane, RRT tree
-	Map3D,	///< accumulated ground-aware grid, path, current point cloud
+	Map3D,	///< accumulated 2.5D map (columns), point cloud of all frames, ground-aware grid below, path
 	Grids,	///< the three grids side by side (top view)
 	GridGroundAware,  ///< one grid, top view
 	GridHeightBand,
