@@ -47,8 +47,11 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 					const double radial = 1 + r2 * (K.k1 + r2 * (K.k2 + r2 * K.k3));
 					const double dx = 2 * K.p1 * xu * yu + K.p2 * (r2 + 2 * xu * xu);
 					const double dy = K.p1 * (r2 + 2 * yu * yu) + 2 * K.p2 * xu * yu;
-					xu = (xd - dx) / radial;
-					yu = (yd - dy) / radial;
+					const double nx = (xd - dx) / radial, ny = (yd - dy) / radial;
+					const bool done = std::abs(nx - xu) + std::abs(ny - yu) < 1e-12;
+					xu = nx;
+					yu = ny;
+					if (done) break;
 				}
 			}
 			const float ky = float(-xu), kz = float(-yu);
