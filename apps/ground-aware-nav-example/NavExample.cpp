@@ -2,9 +2,16 @@
 #include "NavExample.h"
 
 #include <mrpt/img/CImage.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/kinematics/CVehicleSimul_DiffDriven.h>
 #include <mrpt/nav/planners/PlannerSimple2D.h>
+#include <mrpt/nav/reactive/CReactiveNavigationSystem.h>
+#include <mrpt/nav/reactive/CRobot2NavInterfaceForSimulator.h>
+#include <mrpt/system/datetime.h>
 
 #include <algorithm>
+#include <fstream>
+#include <sstream>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -143,6 +150,112 @@ mrpt::maps::CSimplePointsMap obstaclePointsRobotFrame(
 			pts.insertPoint(float(lx), float(ly), opts.z);
 		}
 	return pts;
+}
+
+namespace
+{
+/** The simulated robot: pose and velocity from the kinematic simulator,
+ * obstacles from the grid (robot frame). */
+class GridSensingRobot : public mrpt::nav::CRobot2NavInterfaceForSimulator_DiffDriven
+{
+   public:
+	GridSensingRobot(
+		mrpt::kinematics::CVehicleSimul_DiffDriven& sim, const mrpt::maps::COccupancyGridMap2D& grid,
+		const ObstacleOptions& oo)
+		: CRobot2NavInterfaceForSimulator_DiffDriven(sim), m_sim(sim), m_grid(grid), m_oo(oo)
+	{
+	}
+	bool senseObstacles(mrpt::maps::CSimplePointsMap& obstacles, mrpt::system::TTimeStamp& t) override
+	{
+		obstacles = obstaclePointsRobotFrame(m_grid, mrpt::poses::CPose2D(m_sim.getCurrentGTPose()), m_oo);
+		t = mrpt::system::now();
+		return true;
+	}
+	// quiet: the defaults print every event
+	void sendNavigationStartEvent() override {}
+	void sendNavigationEndEvent() override {}
+	void sendWaySeemsBlockedEvent() override {}
+	void sendApparentCollisionEvent() override {}
+	void sendCannotGetCloserToBlockedTargetEvent() override {}
+
+   private:
+	mrpt::kinematics::CVehicleSimul_DiffDriven& m_sim;
+	const mrpt::maps::COccupancyGridMap2D& m_grid;
+	ObstacleOptions m_oo;
+};
+
+const char* stateName(mrpt::nav::CAbstractNavigator::TState s)
+{
+	switch (s)
+	{
+		case mrpt::nav::CAbstractNavigator::IDLE: return "IDLE";
+		case mrpt::nav::CAbstractNavigator::NAVIGATING: return "NAVIGATING";
+		case mrpt::nav::CAbstractNavigator::SUSPENDED: return "SUSPENDED";
+		case mrpt::nav::CAbstractNavigator::NAV_ERROR: return "NAV_ERROR";
+	}
+	return "?";
+}
+}  // namespace
+
+ReactiveResult runReactiveNavigation(
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start,
+	const mrpt::math::TPoint2D& goal, const ReactiveOptions& opts)
+{
+	std::ifstream f(opts.baseConfig);
+	if (!f) throw std::runtime_error("cannot read the reactive navigator config " + opts.baseConfig);
+	std::stringstream text;
+	text << f.rdbuf();
+	mrpt::config::CConfigFileMemory cfg(text.str());
+	const double h = opts.robotHalfSize;
+	const std::string xs = mrpt::format("%f %f %f %f", -h, h, h, -h);
+	const std::string ys = mrpt::format("%f %f %f %f", h, h, -h, -h);
+	cfg.write("CAbstractPTGBasedReactive", "ptg_cache_files_directory", opts.cacheDir);
+	cfg.write("CAbstractPTGBasedReactive", "enable_obstacle_filtering", "false");
+	cfg.write("CAbstractPTGBasedReactive", "robotMax_V_mps", opts.maxSpeed);
+	cfg.write("CAbstractPTGBasedReactive", "ref_distance", opts.refDistance);
+	cfg.write("CReactiveNavigationSystem", "RobotModel_shape2D_xs", xs);
+	cfg.write("CReactiveNavigationSystem", "RobotModel_shape2D_ys", ys);
+	cfg.write("CReactiveNavigationSystem", "RobotModel_circular_shape_radius", h);
+	for (int i = 0; i < cfg.read_int("CReactiveNavigationSystem", "PTG_COUNT", 0); i++)
+	{
+		cfg.write("CReactiveNavigationSystem", mrpt::format("PTG%d_refDistance", i), opts.refDistance);
+		cfg.write("CReactiveNavigationSystem", mrpt::format("PTG%d_v_max_mps", i), opts.maxSpeed);
+	}
+
+	mrpt::kinematics::CVehicleSimul_DiffDriven sim;
+	sim.setCurrentGTPose(start);
+	GridSensingRobot robot(sim, grid, opts.obstacles);
+	robot.setMinLoggingLevel(mrpt::system::LVL_ERROR);
+	mrpt::nav::CReactiveNavigationSystem nav(robot, false, false);
+	nav.setMinLoggingLevel(mrpt::system::LVL_ERROR);
+	nav.loadConfigFile(cfg);
+	nav.initialize();
+
+	mrpt::nav::CAbstractNavigator::TNavigationParams np;
+	np.target.target_coords = mrpt::math::TPose2D(goal.x, goal.y, 0);
+	np.target.targetAllowedDistance = opts.targetAllowedDistance;
+	np.target.targetIsRelative = false;
+	nav.navigate(&np);
+
+	ReactiveResult r;
+	r.trajectory.push_back(sim.getCurrentGTPose());
+	for (double t = 0; t < opts.maxTime; t += opts.dt)
+	{
+		nav.navigationStep();
+		sim.simulateOneTimeStep(opts.dt);
+		r.trajectory.push_back(sim.getCurrentGTPose());
+		r.seconds = t + opts.dt;
+		if (nav.getCurrentState() != mrpt::nav::CAbstractNavigator::NAVIGATING) break;
+	}
+	r.endState = stateName(nav.getCurrentState());
+	// the delay logger dumps its table when destroyed: keep the console quiet
+	auto& delays = const_cast<mrpt::system::CTimeLogger&>(nav.getDelaysTimeLogger());
+	delays.clear(true);
+	delays.enable(false);
+	const auto& p = r.trajectory.back();
+	r.reached = nav.getCurrentState() == mrpt::nav::CAbstractNavigator::IDLE &&
+				std::hypot(p.x - goal.x, p.y - goal.y) <= opts.targetAllowedDistance + 0.1;
+	return r;
 }
 
 double distanceToHoles(const gam::sim::Scene& scene, double x, double y, double step)

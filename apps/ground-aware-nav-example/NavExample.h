@@ -15,6 +15,7 @@
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/math/TPoint2D.h>
+#include <mrpt/math/TPose2D.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/poses/CPose2D.h>
 #include <mrpt/poses/CPose3D.h>
@@ -93,6 +94,38 @@ struct ObstacleOptions
 mrpt::maps::CSimplePointsMap obstaclePointsRobotFrame(
 	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::poses::CPose2D& robotPose,
 	const ObstacleOptions& opts = {});
+
+struct ReactiveOptions
+{
+	/** MRPT's example reactive-navigator configuration (package mrpt-common);
+	 * the keys below override it. */
+	std::string baseConfig = "/usr/share/mrpt/config_files/navigation-ptgs/reactive2d_config.ini";
+	std::string cacheDir = "/tmp";	///< PTG look-up table cache files go here
+	double robotHalfSize = 0.25;  ///< square robot footprint, half side [m]
+	double refDistance = 4.0;  ///< PTG range [m]
+	double maxSpeed = 0.5;	///< [m/s]
+	double maxTime = 40;  ///< simulated seconds
+	double dt = 0.05;  ///< simulation step [s]
+	float targetAllowedDistance = 0.3f;
+	ObstacleOptions obstacles;
+};
+
+struct ReactiveResult
+{
+	bool reached = false;  ///< the navigator ended (IDLE) within targetAllowedDistance
+	std::string endState;  ///< IDLE / NAVIGATING / SUSPENDED / NAV_ERROR
+	std::vector<mrpt::math::TPose2D> trajectory;  ///< simulated robot poses
+	double seconds = 0;	 ///< simulated time used
+};
+
+/** Closed loop with MRPT's reactive navigator: a CReactiveNavigationSystem
+ * (config: opts.baseConfig + overrides) drives a simulated differential robot
+ * (CVehicleSimul_DiffDriven) from `start` to `goal`; at every step its
+ * senseObstacles() returns obstaclePointsRobotFrame(grid, current pose). The
+ * grid is static (already mapped). Throws if the base config is missing. */
+ReactiveResult runReactiveNavigation(
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start,
+	const mrpt::math::TPoint2D& goal, const ReactiveOptions& opts = {});
 
 /** Smallest distance [m] from a point to the union of the scene's holes
  * (0 inside one), sampled on a grid of `step` metres inside each hole. */

@@ -2,11 +2,12 @@
 // scene with a floor hole on the straight line from start to goal with the
 // ground-aware grid and with the height-band baseline, plans on both with
 // mrpt::nav::PlannerSimple2D and exports the ground-aware obstacles as the
-// robot-frame CSimplePointsMap MRPT's reactive navigator consumes.
+// robot-frame CSimplePointsMap MRPT's reactive navigator consumes, and
+// drives CReactiveNavigationSystem with them (simulated robot).
 //
 // usage: ground-aware-nav-example [--scene config/scenes/nav_hole.scene]
 //            [--start 0,0] [--goal 4.5,0] [--robot-radius 0.3] [--out DIR]
-//            [--no-noise] [--seed N]
+//            [--no-noise] [--seed N] [--no-reactive] [--reactive-config FILE]
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include <cstdio>
@@ -43,6 +44,10 @@ int main(int argc, char** argv)
 			"", "out", "write pictures, grids and obstacle points here", false, "", "DIR", cmd);
 		TCLAP::ValueArg<unsigned> argSeed("", "seed", "noise seed", false, 1, "N", cmd);
 		TCLAP::SwitchArg argNoNoise("", "no-noise", "exact sensor", cmd);
+		TCLAP::SwitchArg argNoReactive("", "no-reactive", "skip the CReactiveNavigationSystem runs", cmd);
+		TCLAP::ValueArg<std::string> argReactiveCfg(
+			"", "reactive-config", "base reactive navigator .ini", false,
+			gam::nav::ReactiveOptions{}.baseConfig, "FILE", cmd);
 		cmd.parse(argc, argv);
 
 		const auto sf = gam::sim::parseSceneFile(argScene.getValue());
@@ -88,6 +93,36 @@ int main(int argc, char** argv)
 			{
 				gam::nav::savePathPicture(*it.grid, plan, start, goal, out + "/" + it.name + "_path.png");
 				it.grid->saveAsBitmapFile(out + "/" + it.name + ".png");
+			}
+		}
+
+		// Closed loop: MRPT's reactive navigator fed with each grid's obstacle points.
+		if (!argNoReactive.getValue())
+		{
+			gam::nav::ReactiveOptions ro;
+			ro.baseConfig = argReactiveCfg.getValue();
+			ro.cacheDir = std::filesystem::temp_directory_path().string();
+			for (const auto& it : items)
+			{
+				const auto r = gam::nav::runReactiveNavigation(*it.grid, {start.x, start.y, 0}, goal, ro);
+				double minHole = 1e9;
+				gam::nav::PlanResult traj;
+				for (const auto& p : r.trajectory)
+				{
+					minHole = std::min(minHole, gam::nav::distanceToHoles(sf.scene, p.x, p.y));
+					traj.path.emplace_back(p.x, p.y);
+				}
+				char buf[300];
+				std::snprintf(
+					buf, sizeof(buf),
+					"%-13s reactive (CReactiveNavigationSystem): %s, %s after %.1f s, closest to a "
+					"hole %.2f m -> %s\n",
+					it.name, r.reached ? "goal reached" : "goal NOT reached", r.endState.c_str(),
+					r.seconds, minHole, minHole == 0 ? "DROVE OVER the hole" : "avoided the hole");
+				std::cout << buf;
+				if (!out.empty())
+					gam::nav::savePathPicture(
+						*it.grid, traj, start, goal, out + "/" + it.name + "_reactive.png");
 			}
 		}
 
