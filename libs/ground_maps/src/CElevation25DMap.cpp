@@ -30,6 +30,25 @@ void CElevation25DMap::TMapDefinition::loadFromConfigFile_map_specific(
 		{"max_y", &max_y, -1e5, 1e5, "grid top edge [m]"},
 		{"resolution", &resolution, 1e-3, 100, "d_r, cell size [m]"}};
 	gam::ini::load(f, source, sC);
+	if (!(min_x < max_x) || !(min_y < max_y))
+		throw std::invalid_argument("[" + sC + "] needs min_x < max_x and min_y < max_y");
+	{
+		// Refuse a grid that would not fit in memory before allocating it (same rule as setSize()).
+		gam::GridGeometry g;
+		g.x_min = min_x;
+		g.y_min = min_y;
+		g.resolution = resolution;
+		g.nx = int(std::lround((max_x - min_x) / resolution));
+		g.ny = int(std::lround((max_y - min_y) / resolution));
+		try
+		{
+			g.validate();
+		}
+		catch (const std::invalid_argument& e)
+		{
+			throw std::invalid_argument("[" + sC + "] " + e.what());
+		}
+	}
 	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 }
 
@@ -128,6 +147,9 @@ void CElevation25DMap::setSize(double x_min, double x_max, double y_min, double 
 	if (!(res > 0)) throw std::invalid_argument("CElevation25DMap: resolution must be > 0");
 	if (!(x_max > x_min) || !(y_max > y_min))
 		throw std::invalid_argument("CElevation25DMap: need min_x < max_x and min_y < max_y");
+	// Cell counts must fit an int before GridGeometry::validate() checks the total.
+	if (!((x_max - x_min) / res < 1e9) || !((y_max - y_min) / res < 1e9))
+		throw std::invalid_argument("CElevation25DMap: grid extent / resolution is too large");
 	gam::GridGeometry g;
 	g.x_min = x_min;
 	g.y_min = y_min;
@@ -326,7 +348,10 @@ void CElevation25DMap::saveAsPngs(const std::string& prefix) const
 		!count.saveToFile(prefix + "_count.png"))
 		throw std::runtime_error("CElevation25DMap: cannot write PNGs with prefix " + prefix);
 	std::ofstream f(prefix + "_scale.txt");
-	f << "# colour scales of " << prefix << "_*.png (one pixel per cell, +y up, black = no data)\n"
+	// The file name only: the directory may be temporary (the mapper writes into a
+	// hidden folder first), and outputs must not depend on it.
+	const std::string stem = prefix.substr(prefix.find_last_of('/') == std::string::npos ? 0 : prefix.find_last_of('/') + 1);
+	f << "# colour scales of " << stem << "_*.png (one pixel per cell, +y up, black = no data)\n"
 	  << "zmax_png: jet colormap, blue = " << zlo << " m, red = " << zhi << " m\n"
 	  << "span_png: hot colormap, black = 0 m, white = " << spanMax << " m\n"
 	  << "count_png: hot colormap of log(1+N_z), white = " << countMax << " samples\n"

@@ -37,6 +37,7 @@ void CGroundAwareOccupancyGrid::TMapDefinition::loadFromConfigFile_map_specific(
 	gam::ini::load(f, source, sC);
 	if (!(min_x < max_x) || !(min_y < max_y))
 		throw std::invalid_argument("[" + sC + "] needs min_x < max_x and min_y < max_y");
+	gam::mrpt_glue::checkGridSize("[" + sC + "]", min_x, max_x, min_y, max_y, resolution);
 	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 	likelihoodOpts.loadFromConfigFile(source, sectionNamePrefix + "_likelihoodOpts");
 	groundOpts.loadFromConfigFile(source, sectionNamePrefix + "_groundOpts");
@@ -144,6 +145,20 @@ void CGroundAwareOccupancyGrid::TGroundAwareOptions::validate() const
 	gam::ini::validate(const_cast<TGroundAwareOptions*>(this)->fields(), "groundOpts");
 	if (!(z_min < z_max)) throw std::invalid_argument("groundOpts: z_min must be < z_max");
 	if (!(min_range < max_range)) throw std::invalid_argument("groundOpts: min_range must be < max_range");
+	{
+		// The per-frame 2.5D map: refuse what would not fit in memory before allocating it.
+		gam::GridGeometry g;
+		g.nx = m_x;
+		g.ny = m_y;
+		try
+		{
+			g.validate();
+		}
+		catch (const std::invalid_argument& e)
+		{
+			throw std::invalid_argument(std::string("groundOpts: m_x x m_y: ") + e.what());
+		}
+	}
 	rrtParams().validate();
 	ismParams().validate();
 }
@@ -269,6 +284,7 @@ bool CGroundAwareOccupancyGrid::internal_insertObservation(
 bool CGroundAwareOccupancyGrid::insert2D(
 	const mrpt::obs::CObservation2DRangeScan& scan, const std::optional<const mrpt::poses::CPose3D>& robotPose)
 {
+	gam::mrpt_glue::checkScanGrowth(*this, (robotPose ? *robotPose : mrpt::poses::CPose3D()) + scan.sensorPose);
 	const bool sparse = int(scan.getScanSize()) < 64 && groundOptions.sparse_scan_upsampling > 1;
 	const auto up = sparse ? upsampleSparseScan(scan, groundOptions.sparse_scan_upsampling)
 						   : mrpt::obs::CObservation2DRangeScan();
@@ -310,6 +326,8 @@ bool CGroundAwareOccupancyGrid::insert3D(
 	};
 	const auto t0 = clk::now();
 	const auto& o = groundOptions;
+	if (!std::isfinite(robotPose.x()) || !std::isfinite(robotPose.y()) || !std::isfinite(robotPose.z()))
+		throw std::invalid_argument("robot pose is not finite");
 	m_last = TFrameDiagnostics{};
 	m_last.detection.nodes.clear();
 
@@ -395,6 +413,14 @@ void CGroundAwareOccupancyGrid::applyEvidence()
 	}
 	const float bx0 = float(g.x_min + x0 * g.resolution), bx1 = float(g.x_min + (x1 + 1) * g.resolution);
 	const float by0 = float(g.y_min + y0 * g.resolution), by1 = float(g.y_min + (y1 + 1) * g.resolution);
+	if (bx0 < getXMin() || bx1 > getXMax() || by0 < getYMin() || by1 > getYMax())
+	{
+		// A robot pose far from everything seen so far (corrupt odometry) would
+		// otherwise grow the grid to terabytes.
+		gam::mrpt_glue::checkGridSize(
+			"growing the ground-aware grid to the robot pose", std::min(bx0, getXMin()), std::max(bx1, getXMax()),
+			std::min(by0, getYMin()), std::max(by1, getYMax()), getResolution());
+	}
 	if (bx0 < getXMin() || bx1 > getXMax() || by0 < getYMin() || by1 > getYMax())
 		resizeGrid(
 			std::min(bx0, getXMin()), std::max(bx1, getXMax()), std::min(by0, getYMin()),

@@ -1,5 +1,6 @@
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
+#include <mrpt/maps/gam_observation_adapters.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/T3DPointsTo2DScanParams.h>
@@ -34,6 +35,7 @@ void CHeightBandOccupancyGrid::TMapDefinition::loadFromConfigFile_map_specific(
 	gam::ini::load(f, source, sC);
 	if (!(min_x < max_x) || !(min_y < max_y))
 		throw std::invalid_argument("[" + sC + "] needs min_x < max_x and min_y < max_y");
+	gam::mrpt_glue::checkGridSize("[" + sC + "]", min_x, max_x, min_y, max_y, resolution);
 	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 	likelihoodOpts.loadFromConfigFile(source, sectionNamePrefix + "_likelihoodOpts");
 	bandOpts.loadFromConfigFile(source, sectionNamePrefix + "_bandOpts");
@@ -115,11 +117,15 @@ bool CHeightBandOccupancyGrid::internal_insertObservation(
 	const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose)
 {
 	using namespace mrpt::obs;
+	const mrpt::poses::CPose3D pose = robotPose ? *robotPose : mrpt::poses::CPose3D();
 	if (IS_CLASS(obs, CObservation3DRangeScan))
 	{
 		// convertTo2DScan() is non-const only because it caches lookup tables.
 		auto& o3 = const_cast<CObservation3DRangeScan&>(dynamic_cast<const CObservation3DRangeScan&>(obs));
 		if (!o3.hasRangeImage || o3.rangeImage.cols() == 0) return false;
+		// MRPT trusts the intrinsics, image size and units: check them here.
+		gam::mrpt_glue::checkRangeScan(o3);
+		gam::mrpt_glue::checkScanGrowth(*this, pose + o3.sensorPose);
 		T3DPointsTo2DScanParams sp;
 		sp.sensorLabel = o3.sensorLabel;
 		sp.use_origin_sensor_pose = true;
@@ -132,6 +138,8 @@ bool CHeightBandOccupancyGrid::internal_insertObservation(
 		if (m_lastScan.getScanSize() == 0) return false;
 		return COccupancyGridMap2D::internal_insertObservation(m_lastScan, robotPose);
 	}
+	if (const auto* o2 = dynamic_cast<const CObservation2DRangeScan*>(&obs))
+		gam::mrpt_glue::checkScanGrowth(*this, pose + o2->sensorPose);
 	return COccupancyGridMap2D::internal_insertObservation(obs, robotPose);
 }
 

@@ -1,5 +1,6 @@
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/maps/COctoMapGrid2D.h>
+#include <mrpt/maps/gam_observation_adapters.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -31,6 +32,7 @@ void COctoMapGrid2D::TMapDefinition::loadFromConfigFile_map_specific(
 	gam::ini::load(f, source, sC);
 	if (!(min_x < max_x) || !(min_y < max_y))
 		throw std::invalid_argument("[" + sC + "] needs min_x < max_x and min_y < max_y");
+	gam::mrpt_glue::checkGridSize("[" + sC + "]", min_x, max_x, min_y, max_y, resolution);
 	octoOpts.loadFromConfigFile(source, sectionNamePrefix + "_octoOpts");
 }
 
@@ -154,11 +156,15 @@ bool COctoMapGrid2D::internal_insertObservation(
 	using namespace mrpt::obs;
 	const auto t0 = std::chrono::steady_clock::now();
 	const mrpt::poses::CPose3D pose = robotPose ? *robotPose : mrpt::poses::CPose3D();
+	for (double v : {pose.x(), pose.y(), pose.z(), pose.yaw(), pose.pitch(), pose.roll()})
+		if (!std::isfinite(v)) throw std::invalid_argument("robot pose is not finite");
 	bool inserted = false;
 	if (IS_CLASS(obs, CObservation3DRangeScan))
 	{
 		const auto& o3 = dynamic_cast<const CObservation3DRangeScan&>(obs);
 		if (!o3.hasRangeImage && !o3.hasPoints3D) return false;
+		// MRPT's unprojectInto() trusts the intrinsics, image size and units: check them here.
+		gam::mrpt_glue::checkRangeScan(o3);
 		mrpt::maps::CSimplePointsMap pts;
 		pts.insertionOptions.minDistBetweenLaserPoints = 0;
 		if (o3.hasRangeImage)
@@ -181,11 +187,23 @@ bool COctoMapGrid2D::internal_insertObservation(
 			{
 				double gx, gy, gz;
 				sensorInMap.composePoint(o3.points3D_x[i], o3.points3D_y[i], o3.points3D_z[i], gx, gy, gz);
+				if (!std::isfinite(gx) || !std::isfinite(gy) || !std::isfinite(gz)) continue;
 				pts.insertPoint(float(gx), float(gy), float(gz));
 			}
 		}
 		if (pts.size() == 0) return false;
 		const mrpt::poses::CPose3D sensorInMap = pose + o3.sensorPose;
+		// OctoMap keys cover +-32768 voxels per axis; liboctomap drops rays from
+		// outside (one stderr warning per point): refuse such a pose clearly.
+		const double reach = 32768.0 * m_octomap.getResolution() - octoOptions.max_range;
+		if (std::abs(sensorInMap.x()) > reach || std::abs(sensorInMap.y()) > reach || std::abs(sensorInMap.z()) > reach)
+		{
+			std::ostringstream msg;
+			msg << "sensor position (" << sensorInMap.x() << ", " << sensorInMap.y() << ", " << sensorInMap.z()
+				<< ") is too large for the octomap: it covers +-" << reach << " m at voxel_size "
+				<< m_octomap.getResolution() << " (minus max_range)";
+			throw std::invalid_argument(msg.str());
+		}
 		m_octomap.insertPointCloud(pts, float(sensorInMap.x()), float(sensorInMap.y()), float(sensorInMap.z()));
 		inserted = true;
 	}
@@ -235,7 +253,12 @@ void COctoMapGrid2D::updateProjection()
 			}
 		}
 	}
-	if (grow) resizeGrid(x0, x1, y0, y1, 0.5f, false);
+	if (grow)
+	{
+		// Octomap keys span 65536 voxels per axis: far poses could need a huge 2D grid.
+		gam::mrpt_glue::checkGridSize("projecting the octomap", x0, x1, y0, y1, getResolution());
+		resizeGrid(x0, x1, y0, y1, 0.5f, false);
+	}
 	fill(0.5f);
 
 	const int sx = int(getSizeX()), sy = int(getSizeY());

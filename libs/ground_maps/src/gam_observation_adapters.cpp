@@ -2,6 +2,7 @@
 #include <mrpt/obs/CObservationPointCloud.h>
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace gam::mrpt_glue
@@ -153,6 +154,53 @@ bool binObservation(
 		return false;
 	if (pointsBinned) *pointsBinned = n;
 	return true;
+}
+
+void checkRangeScan(const mrpt::obs::CObservation3DRangeScan& o)
+{
+	if (!finitePose(o.sensorPose))
+		throw std::invalid_argument("CObservation3DRangeScan.sensorPose is not finite");
+	if (o.hasRangeImage && o.rangeImage.rows() > 0 && o.rangeImage.cols() > 0)
+	{
+		const PinholeIntrinsics K = intrinsicsOf(o);
+		K.validate();
+		if (int(o.rangeImage.rows()) != K.height || int(o.rangeImage.cols()) != K.width)
+			throw std::invalid_argument(
+				"range image is " + std::to_string(o.rangeImage.cols()) + "x" +
+				std::to_string(o.rangeImage.rows()) + " but the camera parameters say " +
+				std::to_string(K.width) + "x" + std::to_string(K.height));
+		if (!(o.rangeUnits > 0) || !std::isfinite(o.rangeUnits))
+			throw std::invalid_argument("rangeUnits must be > 0 (got " + std::to_string(o.rangeUnits) + ")");
+	}
+	if (o.hasPoints3D &&
+		(o.points3D_y.size() != o.points3D_x.size() || o.points3D_z.size() != o.points3D_x.size()))
+		throw std::invalid_argument("CObservation3DRangeScan.points3D_x/y/z sizes differ");
+}
+
+void checkGridSize(const std::string& what, double x0, double x1, double y0, double y1, double resolution)
+{
+	if (!std::isfinite(x0) || !std::isfinite(x1) || !std::isfinite(y0) || !std::isfinite(y1) ||
+		!std::isfinite(resolution) || !(resolution > 0))
+		throw std::invalid_argument(what + ": grid extent or resolution is not finite");
+	const double nx = std::ceil((x1 - x0) / resolution), ny = std::ceil((y1 - y0) / resolution);
+	if (nx * ny > kMaxGridCells)
+	{
+		std::ostringstream s;
+		s << what << ": a grid of " << nx << " x " << ny << " cells (x " << x0 << " to " << x1 << ", y " << y0
+		  << " to " << y1 << " at " << resolution << " m) is too large (limit " << kMaxGridCells
+		  << " cells); shrink the area or use a coarser resolution";
+		throw std::invalid_argument(s.str());
+	}
+}
+
+void checkScanGrowth(const mrpt::maps::COccupancyGridMap2D& g, const mrpt::poses::CPose3D& sensorInMap)
+{
+	if (!finitePose(sensorInMap)) throw std::invalid_argument("robot or sensor pose is not finite");
+	const double reach = std::max(0.0, double(g.insertionOptions.maxDistanceInsertion)) + 1.0;
+	const double x = sensorInMap.x(), y = sensorInMap.y();
+	checkGridSize(
+		"growing the grid to the scan", std::min<double>(g.getXMin(), x - reach), std::max<double>(g.getXMax(), x + reach),
+		std::min<double>(g.getYMin(), y - reach), std::max<double>(g.getYMax(), y + reach), g.getResolution());
 }
 
 }  // namespace gam::mrpt_glue

@@ -10,8 +10,33 @@
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
 
+#include <cstdlib>
 #include <fstream>
+#include <new>
 #include <stdexcept>
+
+// MRPT 2.5's aligned_allocator_cpp11 (CMatrixDynamic, range images, point
+// clouds) never checks what mrpt::aligned_malloc() returns: a corrupt rawlog whose
+// image or matrix size field asks for terabytes makes it memset a null pointer
+// (SIGSEGV inside CObservation3DRangeScan::serializeFrom). This definition
+// interposes libmrpt-core's in every program that links ground_mapper (the
+// executable's symbol wins), and throws std::bad_alloc instead, so the reader
+// reports "cannot read rawlog ... corrupt". Same alignment rule as MRPT's; memory
+// from it is released by mrpt::aligned_free() = free(), as MRPT's own.
+namespace mrpt
+{
+void* aligned_malloc(size_t size, size_t alignment)
+{
+	// No single MRPT buffer of a sane rawlog comes near this (a 16-bit 640x480
+	// range image is 600 KiB): larger means a corrupt size field.
+	constexpr size_t kLimit = size_t(2) << 30;
+	if (alignment == 0 || size > kLimit) throw std::bad_alloc();
+	if (size % alignment != 0) size = (size / alignment + 1) * alignment;
+	void* p = std::aligned_alloc(alignment, size);
+	if (!p && size) throw std::bad_alloc();
+	return p;
+}
+}  // namespace mrpt
 
 namespace gam::mapper
 {
@@ -97,6 +122,12 @@ bool RawlogFrameReader::next(Frame& f)
 		}
 		catch (const mrpt::serialization::CExceptionEOF&)
 		{
+			// zlib stops returning data on a corrupt deflate stream too: only the
+			// real end of the file is a clean end.
+			if (!m_in.checkEOF())
+				throw std::runtime_error(
+					"cannot read rawlog " + m_path + " at entry " + std::to_string(m_entry) +
+					" (corrupt: the gzip stream cannot be decompressed past this point)");
 			m_eof = true;
 			continue;
 		}

@@ -3,6 +3,7 @@
 // observations into BinnedPoints of an ElevationGrid.
 #pragma once
 
+#include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/maps/CPointsMap.h>
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
@@ -42,5 +43,28 @@ bool binObservation(
 size_t binPointCloud(
 	const mrpt::maps::CPointsMap& pts, const mrpt::poses::CPose3D& pose,
 	const ProjectionFilter& f, const ElevationGrid& grid, BinnedPoints& out);
+
+/** Checks a 3D scan before it reaches MRPT code that trusts it (the comparison
+ * maps hand it to convertTo2DScan() / unprojectInto()): finite sensorPose; for a
+ * range image, intrinsics (PinholeIntrinsics::validate), image size = cameraParams
+ * size and rangeUnits > 0; for points3D, equal x/y/z sizes. Throws
+ * std::invalid_argument naming the field. */
+void checkRangeScan(const mrpt::obs::CObservation3DRangeScan& o);
+
+/** Largest 2D occupancy grid any map of this plugin creates or grows to:
+ * 2^28 cells (256 MiB of 8-bit cells; MRPT keeps more per cell for some
+ * operations). A .ini extent or a robot pose that needs more is an error. */
+constexpr double kMaxGridCells = double(1u << 28);
+
+/** Throws std::invalid_argument ("<what>: a grid of NxM cells ... is too large")
+ * if [x0,x1]x[y0,y1] at `resolution` needs more than kMaxGridCells cells, or if
+ * any value is not finite. */
+void checkGridSize(const std::string& what, double x0, double x1, double y0, double y1, double resolution);
+
+/** Before MRPT's beam model inserts a 2D scan taken at `sensorInMap` into `g`
+ * (it grows the grid to hold the rays, up to insertionOptions.maxDistanceInsertion):
+ * throws std::invalid_argument if the pose is not finite or if the grown grid would
+ * exceed kMaxGridCells (a robot pose far from everything seen so far). */
+void checkScanGrowth(const mrpt::maps::COccupancyGridMap2D& g, const mrpt::poses::CPose3D& sensorInMap);
 
 }  // namespace gam::mrpt_glue

@@ -1,0 +1,283 @@
+// Bad rawlogs through the mapper's streaming reader (gam::mapper::RawlogFrameReader)
+// and every frame it yields into every map class: empty files, files cut in the middle
+// of an object, flipped bytes, objects of unexpected classes. Each gives frames and
+// then a std::runtime_error naming the entry, or a clean end; never a crash.
+// Already covered elsewhere (not repeated): tests/mapper BadInputsGiveOneLineErrors
+// (missing file, a text file, an odometry-only rawlog).
+#include <gam/mapper/Mapper.h>
+#include <gam/mapper/RawlogFrames.h>
+#include <gtest/gtest.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/io/CFileOutputStream.h>
+#include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CObservationGPS.h>
+#include <mrpt/obs/CObservationImage.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose2D.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "robustness_helpers.h"
+
+namespace fs = std::filesystem;
+using namespace gam::mapper;
+
+namespace
+{
+const std::string kTmp = std::string(GAM_TEST_TMP_DIR) + "/rawlogs_p" + std::to_string(getpid());
+
+std::string tmpFile(const std::string& name)
+{
+	fs::create_directories(kTmp);
+	return kTmp + "/" + name;
+}
+
+std::string slurp(const std::string& f)
+{
+	std::ifstream i(f, std::ios::binary);
+	std::ostringstream s;
+	s << i.rdbuf();
+	return s.str();
+}
+void spit(const std::string& f, const std::string& bytes) { std::ofstream(f, std::ios::binary) << bytes; }
+
+/** Observations-format rawlog: per frame odometry + a small depth frame + a 2D scan. */
+template <class Stream>
+void writeObsRawlog(Stream& out, int frames)
+{
+	auto ar = mrpt::serialization::archiveFrom(out);
+	for (int k = 0; k < frames; k++)
+	{
+		mrpt::obs::CObservationOdometry odo;
+		odo.odometry = mrpt::poses::CPose2D(0.2 * k, 0, 0);
+		ar << odo;
+		auto o = testscene::renderDepth(robust::floorAndBox(), robust::kMount, {}, 64, 48);
+		ar << *o;
+		mrpt::obs::CObservation2DRangeScan s;
+		s.aperture = float(M_PI / 4);
+		s.maxRange = 50;
+		s.resizeScan(16);
+		for (size_t i = 0; i < 16; i++)
+		{
+			s.setScanRange(i, 3.0f);
+			s.setScanRangeValidity(i, true);
+		}
+		ar << s;
+	}
+}
+
+std::string plainRawlog(int frames)
+{
+	const std::string f = tmpFile("plain_" + std::to_string(frames) + ".rawlog");
+	mrpt::io::CFileOutputStream out(f);
+	writeObsRawlog(out, frames);
+	return f;
+}
+
+struct ReadOutcome
+{
+	size_t frames = 0;
+	bool threw = false;
+	std::string error;
+};
+
+/** Reads every frame and inserts it into a fresh map of every class (exceptions
+ * from the maps are acceptable answers to corrupt observations). */
+ReadOutcome readAll(const std::string& path)
+{
+	ReadOutcome r;
+	auto maps = robust::allMaps();
+	try
+	{
+		RawlogFrameReader rd(path);
+		Frame f;
+		while (rd.next(f))
+		{
+			r.frames++;
+			for (auto& m : maps)
+			{
+				try
+				{
+					m.map->insertObservation(*f.obs, f.robotPose);
+				}
+				catch (const std::exception&)
+				{
+				}
+			}
+		}
+	}
+	catch (const std::runtime_error& e)
+	{
+		r.threw = true;
+		r.error = e.what();
+	}
+	return r;
+}
+}  // namespace
+
+TEST(RobustRawlogs, EmptyFilesEndCleanlyWithNoFrames)
+{
+	const std::string empty = tmpFile("empty.rawlog");
+	spit(empty, "");
+	auto r = readAll(empty);
+	EXPECT_FALSE(r.threw) << r.error;
+	EXPECT_EQ(r.frames, 0u);
+	// A gzip stream holding nothing.
+	const std::string emptyGz = tmpFile("empty_gz.rawlog");
+	{
+		mrpt::io::CFileGZOutputStream o(emptyGz);
+	}
+	r = readAll(emptyGz);
+	EXPECT_FALSE(r.threw) << r.error;
+	EXPECT_EQ(r.frames, 0u);
+	// The mapper says so (exit code 1 in the app).
+	MapperOptions mo;
+	mo.rawlogPath = empty;
+	mo.outDir = tmpFile("out_empty");
+	mo.configText = "[map]\ngroundAwareGrid_count=1\n";
+	mo.progress = false;
+	Mapper m(mo);
+	try
+	{
+		m.run();
+		ADD_FAILURE() << "an empty rawlog gave maps";
+	}
+	catch (const RunError& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("no usable observation"), std::string::npos) << e.what();
+	}
+}
+
+TEST(RobustRawlogs, FileCutInTheMiddleOfAnObjectIsAnErrorNamingTheEntry)
+{
+	const std::string good = plainRawlog(3);
+	const std::string bytes = slurp(good);
+	ASSERT_GT(bytes.size(), 1000u);
+	const auto full = readAll(good);
+	ASSERT_FALSE(full.threw) << full.error;
+	ASSERT_EQ(full.frames, 6u);
+	// Cut everywhere (in steps, plus the first and last bytes).
+	size_t clean = 0, errors = 0;
+	std::vector<size_t> cuts = {1, 2, 5, 10, bytes.size() - 1, bytes.size() - 2};
+	for (size_t c = 17; c < bytes.size(); c += 97) cuts.push_back(c);
+	const std::string cut = tmpFile("cut.rawlog");
+	for (size_t c : cuts)
+	{
+		spit(cut, bytes.substr(0, c));
+		const auto r = readAll(cut);
+		EXPECT_LE(r.frames, full.frames) << "cut at " << c;
+		if (r.threw)
+		{
+			errors++;
+			EXPECT_NE(r.error.find("entry"), std::string::npos) << r.error;
+			EXPECT_NE(r.error.find("corrupt"), std::string::npos) << "cut at " << c << ": " << r.error;
+		}
+		else
+			clean++;
+	}
+	EXPECT_GT(errors, cuts.size() / 2) << "a cut inside an object must not pass as a clean end";
+}
+
+TEST(RobustRawlogs, FlippedBytesNeverCrash)
+{
+	const std::string good = plainRawlog(2);
+	const std::string bytes = slurp(good);
+	std::mt19937 rng(12345);
+	const std::string bad = tmpFile("flipped.rawlog");
+	size_t errors = 0, frames = 0;
+	for (int t = 0; t < 150; t++)
+	{
+		std::string b = bytes;
+		const int n = 1 + int(rng() % 4);
+		for (int k = 0; k < n; k++) b[rng() % b.size()] ^= char(1 + rng() % 255);
+		spit(bad, b);
+		if (getenv("GAM_ROBUST_DEBUG")) fprintf(stderr, "mutant %d\n", t), spit(bad + "." + std::to_string(t), b);
+		const auto r = readAll(bad);
+		errors += r.threw;
+		frames += r.frames;
+	}
+	RecordProperty("mutants_with_errors", int(errors));
+	SUCCEED() << errors << " of 150 mutants gave an error, " << frames << " frames read in total";
+}
+
+TEST(RobustRawlogs, CorruptGzipStreamIsAnError)
+{
+	const std::string gz = tmpFile("good.rawlog.gz");
+	{
+		mrpt::io::CFileGZOutputStream out(gz);
+		writeObsRawlog(out, 2);
+	}
+	const std::string bytes = slurp(gz);
+	ASSERT_GT(bytes.size(), 100u);
+	// Garbage in the middle of the deflate stream, and a cut one.
+	std::string b = bytes;
+	for (size_t i = bytes.size() / 2; i < bytes.size() / 2 + 16; i++) b[i] = char(0xA5);
+	const std::string bad = tmpFile("bad.rawlog.gz");
+	spit(bad, b);
+	auto r = readAll(bad);
+	EXPECT_TRUE(r.threw) << r.frames << " frames, no error";
+	spit(bad, bytes.substr(0, bytes.size() / 2));
+	r = readAll(bad);
+	EXPECT_TRUE(r.threw) << r.frames << " frames, no error";
+}
+
+TEST(RobustRawlogs, ObjectsOfUnexpectedClassesAreSkipped)
+{
+	const std::string f = tmpFile("odd_classes.rawlog");
+	{
+		mrpt::io::CFileGZOutputStream out(f);
+		auto ar = mrpt::serialization::archiveFrom(out);
+		ar << mrpt::poses::CPose2D(1, 2, 0.3);	// not an observation at all
+		mrpt::maps::CSimpleMap sm;
+		ar << sm;
+		mrpt::obs::CObservationImage img;
+		img.image.resize(8, 8, mrpt::img::CH_GRAY);
+		ar << img;
+		mrpt::obs::CObservationGPS gps;
+		ar << gps;
+		// A sensory frame with an image, an empty 3D scan and a real one.
+		mrpt::obs::CSensoryFrame sf;
+		sf.insert(mrpt::obs::CObservationImage::Create(img));
+		sf.insert(mrpt::obs::CObservation3DRangeScan::Create());
+		sf.insert(testscene::renderDepth(robust::floorAndBox(), robust::kMount, {}, 64, 48));
+		ar << sf;
+		mrpt::obs::CActionCollection acts;  // no movement estimation in it
+		ar << acts;
+	}
+	RawlogFrameReader rd(f);
+	Frame fr;
+	size_t n = 0;
+	while (rd.next(fr))
+	{
+		n++;
+		EXPECT_TRUE(IS_CLASS(*fr.obs, mrpt::obs::CObservation3DRangeScan));
+	}
+	EXPECT_EQ(n, 1u);
+	EXPECT_EQ(rd.entriesRead(), 6u);
+	EXPECT_GE(rd.skippedObservations(), 5u);
+
+	// Only unexpected classes: the mapper says there is nothing to map.
+	const std::string g = tmpFile("only_odd.rawlog");
+	{
+		mrpt::io::CFileGZOutputStream out(g);
+		auto ar = mrpt::serialization::archiveFrom(out);
+		ar << mrpt::poses::CPose2D(1, 2, 0.3);
+		mrpt::obs::CObservationImage img;
+		ar << img;
+	}
+	MapperOptions mo;
+	mo.rawlogPath = g;
+	mo.outDir = tmpFile("out_odd");
+	mo.configText = "[map]\nCElevation25DMap_count=1\n";
+	mo.progress = false;
+	Mapper m(mo);
+	EXPECT_THROW(m.run(), RunError);
+}
