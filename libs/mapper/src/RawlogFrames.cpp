@@ -29,7 +29,7 @@ void* aligned_malloc(size_t size, size_t alignment)
 {
 	// No single MRPT buffer of a sane rawlog comes near this (a 16-bit 640x480
 	// range image is 600 KiB): larger means a corrupt size field.
-	constexpr size_t kLimit = size_t(2) << 30;
+	constexpr size_t kLimit = size_t(1) << 30;
 	if (alignment == 0 || size > kLimit) throw std::bad_alloc();
 	if (size % alignment != 0) size = (size / alignment + 1) * alignment;
 	void* p = std::aligned_alloc(alignment, size);

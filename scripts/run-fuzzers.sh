@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (tests/fuzz/, clang, ASan + UBSan) and runs each for
+# SECONDS (default 60), starting from the seed corpus in tests/fuzz/corpus/<target>/.
+# usage: scripts/run-fuzzers.sh [SECONDS] [BUILD_DIR]   (default build dir: build-fuzz/)
+#
+# Targets:
+#   fuzz_rawlog  rawlog bytes -> the mapper's streaming reader -> every frame into
+#                CElevation25DMap, CGroundAwareOccupancyGrid, CHeightBandOccupancyGrid,
+#                COctoMapGrid2D
+#   fuzz_ini     .ini text -> the mapper's validated map definitions -> CMultiMetricMap
+#                -> one small depth frame into every map
+# New inputs go to BUILD_DIR/corpus/<target>/ (the committed seeds are not modified);
+# a crash, sanitizer report, leak, timeout (> 20 s per input) or an allocation over
+# 1.1 GB (-malloc_limit_mb) is written to BUILD_DIR/artifacts/ and fails the script.
+# Reproduce one with: BUILD_DIR/bin/<target> BUILD_DIR/artifacts/<file>
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+secs=${1:-60}
+build=${2:-$here/build-fuzz}
+jobs=${GAM_JOBS:-$(nproc)}
+export CCACHE_DIR=${CCACHE_DIR:-$HOME/.cache/ccache}
+cxx=${GAM_FUZZ_CXX:-$(command -v clang++ || command -v clang++-14 || true)}
+if [ -z "$cxx" ]; then
+  echo "run-fuzzers: clang++ not found (Debian: apt-get install clang libclang-rt-14-dev)" >&2
+  exit 2
+fi
+
+cmake -S "$here/tests/fuzz" -B "$build" -DCMAKE_CXX_COMPILER="$cxx" >/dev/null
+cmake --build "$build" -j "$jobs"
+
+export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1:allocator_may_return_null=1:quarantine_size_mb=64"
+export LSAN_OPTIONS="suppressions=$here/tests/sanitizers/lsan.supp:print_suppressions=0"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+mkdir -p "$build/artifacts"
+status=0
+for t in fuzz_rawlog fuzz_ini; do
+  seeds="$here/tests/fuzz/corpus/${t#fuzz_}"
+  work="$build/corpus/$t"
+  mkdir -p "$work"
+  echo "== $t: ${secs} s, seeds $(ls "$seeds" | wc -l) files, corpus $work"
+  log="$build/$t.log"
+  if "$build/bin/$t" -max_total_time="$secs" -timeout=20 -rss_limit_mb=3072 -malloc_limit_mb=1100 \
+      -max_len=65536 -print_final_stats=1 -artifact_prefix="$build/artifacts/$t-" \
+      "$work" "$seeds" >"$log" 2>&1; then
+    grep -E "^stat::number_of_executed_units|^stat::new_units_added|^#[0-9]+.*DONE" "$log" || true
+    echo "== $t: no crash ($(ls "$work" | wc -l) corpus files)"
+  else
+    status=1
+    echo "== $t: FAILED, see $log" >&2
+    grep -E "ERROR|SUMMARY|Test unit written|==[0-9]+==" "$log" | head -20 >&2 || true
+  fi
+done
+exit $status
