@@ -229,6 +229,8 @@ ReactiveResult runReactiveNavigation(
 	mrpt::nav::CReactiveNavigationSystem nav(robot, false, false);
 	nav.setMinLoggingLevel(mrpt::system::LVL_ERROR);
 	nav.loadConfigFile(cfg);
+	// not read from the .ini by MRPT 2.5.8: set it here (else ReacNavGrid_*.dat.gz land in the cwd)
+	nav.params_abstract_ptg_navigator.ptg_cache_files_directory = opts.cacheDir;
 	nav.initialize();
 
 	mrpt::nav::CAbstractNavigator::TNavigationParams np;
