@@ -256,6 +256,7 @@ TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
 	const GridGeometry& g = frame.geometry();
 	IsmParams p;
 	p.max_range = 4.0;
+	p.min_obstacle_points = 1;	// the hole cells have one sample each (see LoneSamples... below)
 	InverseSensorModel ism(p);
 	IsmStats st;
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
@@ -426,6 +427,7 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	const ElevationGrid frame = stepFrame();
 	const GridGeometry& g = frame.geometry();
 	IsmParams prm;
+	prm.min_obstacle_points = 1;  // the lower floor has one sample per cell
 	IsmStats st;
 	// By default a drop voxel needs 3 samples to cast a ray: these have one.
 	InverseSensorModel strict(prm);
@@ -473,6 +475,7 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 
 	// Limited ray length: only the 0.2 m before each voxel.
 	IsmParams p;
+	p.min_obstacle_points = 1;
 	p.drop_ray_min_points = 1;
 	p.max_drop_ray_length = 0.2;
 	ism.setParams(p);
@@ -528,6 +531,7 @@ TEST(InverseSensorModel, NeutralEvidenceIsNeverListed)
 	p.K_g = 0;
 	p.K_m = 0;
 	p.drop_ray_min_points = 1;	// the lower cells have one sample: let them cast rays
+	p.min_obstacle_points = 1;
 	InverseSensorModel ism(p);
 	IsmStats st;
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
@@ -602,4 +606,25 @@ TEST(InverseSensorModel, RampIsGroundOnlyWithLocalPlanes)
 	// The flat floor is ground either way.
 	EXPECT_GT(f1, 0.99);
 	EXPECT_GT(f0, 0.99);
+}
+
+TEST(InverseSensorModel, LoneSamplesGiveNoObstacleEvidence)
+{
+	// The hole cells of the scene frame hold one sample each: with the default
+	// min_obstacle_points = 2 they are classified but give no evidence, like a
+	// depth spike; the 5-sample box still does.
+	const ElevationGrid frame = sceneFrame();
+	const GridGeometry& g = frame.geometry();
+	IsmParams p;
+	p.max_range = 4.0;
+	ASSERT_EQ(p.min_obstacle_points, 2);
+	InverseSensorModel ism(p);
+	IsmStats st;
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	EXPECT_EQ(st.sparse, 4u);
+	EXPECT_EQ(st.drop, 0u);
+	EXPECT_EQ(ism.evidence()[g.index(g.ix(1.55), g.iy(-0.45))], 0.5f);
+	EXPECT_GT(ism.evidence()[g.index(g.ix(1.25), g.iy(0.55))], 0.5f);
+	p.min_obstacle_points = 0;
+	EXPECT_THROW(InverseSensorModel(p).compute(frame, handDetection(kFloor), {0, 0, 1}, st), std::invalid_argument);
 }

@@ -33,6 +33,7 @@ void IsmParams::validate() const
 	require(noise_sigmas >= 0 && noise_sigmas <= 10, "noise_sigmas", "in [0, 10]", noise_sigmas);
 	require(robot_height > 0, "robot_height", "> 0 m", robot_height);
 	require(max_range > 0, "max_range", "> 0 m", max_range);
+	require(min_obstacle_points >= 1, "min_obstacle_points", ">= 1", min_obstacle_points);
 	require(drop_ray_min_points >= 1, "drop_ray_min_points", ">= 1", drop_ray_min_points);
 	require(max_drop_ray_length >= 0, "max_drop_ray_length", ">= 0 m", max_drop_ray_length);
 	require(plane_support_radius >= 0, "plane_support_radius", ">= 0 m", plane_support_radius);
@@ -194,6 +195,12 @@ void InverseSensorModel::compute(
 			case VoxelClass::Obstacle:
 			case VoxelClass::Drop:
 			{
+				if (c.count < uint32_t(std::max(1, m_params.min_obstacle_points)))
+				{
+					// A lone return (a depth spike) is no evidence of anything.
+					stats.sparse++;
+					break;
+				}
 				(cls == VoxelClass::Drop ? stats.drop : stats.obstacle)++;
 				const double rho = ism::voxelDensity(c.count, c.span(), res);
 				put(idx, float(ism::obstacleProbability(ism::densityConfidence(rho, m_params), m_params)));
