@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CFileOutputStream.h>
+#include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CObservationGPS.h>
@@ -280,4 +281,45 @@ TEST(RobustRawlogs, ObjectsOfUnexpectedClassesAreSkipped)
 	mo.progress = false;
 	Mapper m(mo);
 	EXPECT_THROW(m.run(), RunError);
+}
+
+TEST(RobustRawlogs, AbsurdElementCountIsAnErrorNotGigabytes)
+{
+	// Found by tests/fuzz/fuzz_rawlog: MRPT resizes a CActionCollection / CSensoryFrame
+	// to the stored count before reading any element; 0x6d9c6da1 elements = 29 GB.
+	for (const auto& [name, version] :
+		 std::vector<std::pair<std::string, char>>{{"mrpt::obs::CActionCollection", 0}, {"mrpt::obs::CSensoryFrame", 2}})
+	{
+		std::string b;
+		b += char(0x80 | name.size());
+		b += name;
+		b += version;
+		b += std::string("\xa1\x6d\x9c\x6d", 4);
+		b += std::string(64, '\0');
+		const std::string f = tmpFile("absurd_count.rawlog");
+		spit(f, b);
+		const auto r = readAll(f);
+		EXPECT_TRUE(r.threw) << name;
+		EXPECT_NE(r.error.find("claims"), std::string::npos) << r.error;
+	}
+}
+
+TEST(RobustRawlogs, AbsurdStringLengthIsAnErrorNotGigabytes)
+{
+	// Found by tests/fuzz/fuzz_rawlog: a corrupt string length (here in a camera
+	// name) made MRPT allocate and zero up to 4 GiB before failing. Programs linking
+	// ground_mapper refuse strings over 64 MiB.
+	mrpt::io::CMemoryStream buf;
+	auto ar = mrpt::serialization::archiveFrom(buf);
+	ar << uint32_t(0xF0000000u) << uint64_t(0);
+	buf.Seek(0);
+	std::string s;
+	EXPECT_THROW(ar >> s, std::runtime_error);
+	// Normal strings still read back.
+	mrpt::io::CMemoryStream ok;
+	auto ar2 = mrpt::serialization::archiveFrom(ok);
+	ar2 << std::string("KINECT");
+	ok.Seek(0);
+	ar2 >> s;
+	EXPECT_EQ(s, "KINECT");
 }

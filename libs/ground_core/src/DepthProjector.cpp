@@ -109,6 +109,8 @@ size_t DepthProjector::project(
 			if (gz < f.z_min || gz > f.z_max) continue;
 			const float fx_ = gx * inv_res, fy_ = gy * inv_res;
 			if (!(fx_ >= 0.f) || !(fy_ >= 0.f)) continue;	// also rejects NaN
+			// Compare as floats first: int() of a value beyond the int range is UB.
+			if (fx_ >= float(g.nx) || fy_ >= float(g.ny)) continue;
 			const int cx = int(fx_), cy = int(fy_);
 			if (cx >= g.nx || cy >= g.ny) continue;
 			out.push(uint32_t(cy) * uint32_t(g.nx) + uint32_t(cx), gz);

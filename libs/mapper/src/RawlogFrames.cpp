@@ -10,6 +10,7 @@
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <new>
@@ -38,9 +39,100 @@ void* aligned_malloc(size_t size, size_t alignment)
 }
 }  // namespace mrpt
 
+// Same kind of problem (found by tests/fuzz/fuzz_rawlog): MRPT's string reader
+// resizes the string to the stored uint32 length before reading it, so one
+// corrupt length field allocates and zeroes up to 4 GiB. This definition
+// (interposing libmrpt-serialization's, same wire format: uint32 length, bytes)
+// refuses lengths no rawlog string has.
+namespace mrpt::serialization
+{
+CArchive& operator>>(CArchive& in, std::string& str)
+{
+	uint32_t n = 0;
+	in.ReadBuffer(&n, sizeof(n));
+	constexpr uint32_t kLimit = 64u << 20;
+	if (n > kLimit)
+		throw std::runtime_error(
+			"corrupt data: a serialized string of " + std::to_string(n) + " bytes (limit 64 MiB)");
+	str.resize(n);
+	if (n) in.ReadBuffer(&str[0], n);
+	return in;
+}
+}  // namespace mrpt::serialization
+
 namespace gam::mapper
 {
 using namespace mrpt::obs;
+
+namespace
+{
+/** A read-only view of the rawlog stream that can look at the start of the next
+ * object before MRPT deserializes it. MRPT 2.5 reads the element count of a
+ * CSensoryFrame / CActionCollection and resizes its container to it before reading
+ * any element: a corrupt count makes a 1 KB rawlog allocate tens of GB (found by
+ * tests/fuzz/fuzz_rawlog). Peeked bytes never exceed the object being read, so the
+ * buffer is always consumed by the following ReadObject(). */
+class PeekStream : public mrpt::io::CStream
+{
+   public:
+	explicit PeekStream(mrpt::io::CStream& in) : m_in(in) {}
+	/** Makes the first n bytes of the rest available in data(); returns how many are. */
+	size_t peek(size_t n)
+	{
+		while (m_buf.size() - m_pos < n)
+		{
+			uint8_t tmp[256];
+			const size_t want = std::min(sizeof(tmp), n - (m_buf.size() - m_pos));
+			const size_t got = m_in.Read(tmp, want);
+			if (got == 0 || got > want) break;	// EOF or error
+			m_buf.insert(m_buf.end(), tmp, tmp + got);
+		}
+		return m_buf.size() - m_pos;
+	}
+	const uint8_t* data() const { return m_buf.data() + m_pos; }
+	size_t Read(void* buffer, size_t count) override
+	{
+		auto* out = static_cast<uint8_t*>(buffer);
+		const size_t fromBuf = std::min(count, m_buf.size() - m_pos);
+		std::copy_n(m_buf.data() + m_pos, fromBuf, out);
+		m_pos += fromBuf;
+		if (fromBuf == count) return count;
+		const size_t got = m_in.Read(out + fromBuf, count - fromBuf);
+		return got > count - fromBuf ? fromBuf : fromBuf + got;
+	}
+	size_t Write(const void*, size_t) override { throw std::logic_error("PeekStream is read-only"); }
+	uint64_t Seek(int64_t, mrpt::io::CStream::TSeekOrigin) override
+	{
+		throw std::logic_error("PeekStream cannot seek");
+	}
+	uint64_t getTotalBytesCount() const override { return m_in.getTotalBytesCount(); }
+	uint64_t getPosition() const override { return m_in.getPosition() - (m_buf.size() - m_pos); }
+
+   private:
+	mrpt::io::CStream& m_in;
+	std::vector<uint8_t> m_buf;
+	size_t m_pos = 0;
+};
+
+/** Rejects a CSensoryFrame / CActionCollection whose element count is absurd
+ * (MRPT's format: byte 0x80|L, L name bytes, version byte, uint32 count LE). */
+void checkContainerCount(PeekStream& ps, const std::string& where)
+{
+	if (ps.peek(1) < 1 || !(ps.data()[0] & 0x80)) return;
+	const size_t L = ps.data()[0] & 0x7F;
+	if (ps.peek(1 + L) < 1 + L) return;
+	const std::string name(reinterpret_cast<const char*>(ps.data()) + 1, L);
+	if (name != "mrpt::obs::CSensoryFrame" && name != "mrpt::obs::CActionCollection") return;
+	if (ps.peek(1 + L + 5) < 1 + L + 5) return;
+	const uint8_t* c = ps.data() + 1 + L + 1;
+	const uint32_t n = uint32_t(c[0]) | uint32_t(c[1]) << 8 | uint32_t(c[2]) << 16 | uint32_t(c[3]) << 24;
+	constexpr uint32_t kMaxElements = 100000;
+	if (n > kMaxElements)
+		throw std::runtime_error(
+			where + " (corrupt: a " + name + " claims " + std::to_string(n) + " elements, limit " +
+			std::to_string(kMaxElements) + ")");
+}
+}  // namespace
 
 bool isUsableScan(const CObservation& o)
 {
@@ -115,9 +207,11 @@ bool RawlogFrameReader::next(Frame& f)
 		if (m_eof) return false;
 
 		mrpt::serialization::CSerializable::Ptr obj;
+		PeekStream ps(m_in);
+		checkContainerCount(ps, "cannot read rawlog " + m_path + " at entry " + std::to_string(m_entry));
 		try
 		{
-			auto ar = mrpt::serialization::archiveFrom(m_in);
+			auto ar = mrpt::serialization::archiveFrom(ps);
 			obj = ar.ReadObject();
 		}
 		catch (const mrpt::serialization::CExceptionEOF&)

@@ -23,9 +23,17 @@ struct GridGeometry
 	double x_max() const { return x_min + nx * resolution; }
 	double y_max() const { return y_min + ny * resolution; }
 	size_t cellCount() const { return size_t(nx) * size_t(ny); }
-	/** Cell index along x, possibly outside [0, nx). */
-	int ix(double x) const { return int(std::floor((x - x_min) / resolution)); }
-	int iy(double y) const { return int(std::floor((y - y_min) / resolution)); }
+	/** Cell index along x, possibly outside [0, nx); saturated for far or
+	 * non-finite coordinates (NaN gives INT_MIN: outside). */
+	int ix(double x) const { return toIndex(std::floor((x - x_min) / resolution)); }
+	int iy(double y) const { return toIndex(std::floor((y - y_min) / resolution)); }
+	static int toIndex(double f)
+	{
+		// A plain int(f) is undefined behaviour beyond the int range (UBSan, fuzz_rawlog).
+		if (f >= 2147483647.0) return std::numeric_limits<int>::max();
+		if (!(f > -2147483648.0)) return std::numeric_limits<int>::min();
+		return int(f);
+	}
 	bool inside(int cx, int cy) const { return cx >= 0 && cy >= 0 && cx < nx && cy < ny; }
 	double cx(int ix_) const { return x_min + (ix_ + 0.5) * resolution; }
 	double cy(int iy_) const { return y_min + (iy_ + 0.5) * resolution; }
