@@ -23,32 +23,17 @@ void CElevation25DMap::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
 {
 	const std::string sC = sectionNamePrefix + "_creationOpts";
-	gam::ini::Fields f = {
-		{"min_x", &min_x, -1e5, 1e5, "grid left edge [m]"},
-		{"max_x", &max_x, -1e5, 1e5, "grid right edge [m]"},
-		{"min_y", &min_y, -1e5, 1e5, "grid bottom edge [m]"},
-		{"max_y", &max_y, -1e5, 1e5, "grid top edge [m]"},
-		{"resolution", &resolution, 1e-3, 100, "d_r, cell size [m]"}};
-	gam::ini::load(f, source, sC);
-	if (!(min_x < max_x) || !(min_y < max_y))
-		throw std::invalid_argument("[" + sC + "] needs min_x < max_x and min_y < max_y");
-	{
-		// Refuse a grid that would not fit in memory before allocating it (same rule as setSize()).
+	gam::ini::loadGridExtent(source, sC, min_x, max_x, min_y, max_y, resolution);
+	// ElevationGrid has its own (smaller) cell limit: refuse before allocating.
+	gam::ini::loadThenCheck({}, source, sC, [&] {
 		gam::GridGeometry g;
 		g.x_min = min_x;
 		g.y_min = min_y;
 		g.resolution = resolution;
 		g.nx = int(std::lround((max_x - min_x) / resolution));
 		g.ny = int(std::lround((max_y - min_y) / resolution));
-		try
-		{
-			g.validate();
-		}
-		catch (const std::invalid_argument& e)
-		{
-			throw std::invalid_argument("[" + sC + "] " + e.what());
-		}
-	}
+		g.validate();
+	});
 	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 }
 
@@ -87,8 +72,7 @@ gam::ini::Fields CElevation25DMap::TInsertionOptions::fields()
 void CElevation25DMap::TInsertionOptions::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& source, const std::string& section)
 {
-	gam::ini::load(fields(), source, section);
-	validate();
+	gam::ini::loadThenCheck(fields(), source, section, [this] { validate(); });
 }
 
 void CElevation25DMap::TInsertionOptions::saveToConfigFile(

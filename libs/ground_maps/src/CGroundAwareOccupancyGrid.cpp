@@ -28,16 +28,7 @@ void CGroundAwareOccupancyGrid::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
 {
 	const std::string sC = sectionNamePrefix + "_creationOpts";
-	gam::ini::Fields f = {
-		{"min_x", &min_x, -1e5, 1e5, "grid left edge [m]"},
-		{"max_x", &max_x, -1e5, 1e5, "grid right edge [m]"},
-		{"min_y", &min_y, -1e5, 1e5, "grid bottom edge [m]"},
-		{"max_y", &max_y, -1e5, 1e5, "grid top edge [m]"},
-		{"resolution", &resolution, 1e-3, 100, "d_r, cell size [m]"}};
-	gam::ini::load(f, source, sC);
-	if (!(min_x < max_x) || !(min_y < max_y))
-		throw std::invalid_argument("[" + sC + "] needs min_x < max_x and min_y < max_y");
-	gam::mrpt_glue::checkGridSize("[" + sC + "]", min_x, max_x, min_y, max_y, resolution);
+	gam::ini::loadGridExtent(source, sC, min_x, max_x, min_y, max_y, resolution);
 	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 	likelihoodOpts.loadFromConfigFile(source, sectionNamePrefix + "_likelihoodOpts");
 	groundOpts.loadFromConfigFile(source, sectionNamePrefix + "_groundOpts");
@@ -124,15 +115,7 @@ gam::ini::Fields CGroundAwareOccupancyGrid::TGroundAwareOptions::fields()
 void CGroundAwareOccupancyGrid::TGroundAwareOptions::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& source, const std::string& section)
 {
-	gam::ini::load(fields(), source, section);
-	try
-	{
-		validate();
-	}
-	catch (const std::invalid_argument& e)
-	{
-		throw std::invalid_argument("[" + section + "] " + e.what());
-	}
+	gam::ini::loadThenCheck(fields(), source, section, [this] { validate(); });
 }
 
 void CGroundAwareOccupancyGrid::TGroundAwareOptions::saveToConfigFile(
@@ -454,10 +437,7 @@ void CGroundAwareOccupancyGrid::serializeTo(mrpt::serialization::CArchive& out) 
 {
 	out << COccupancyGridMap2D::serializeGetVersion();
 	COccupancyGridMap2D::serializeTo(out);
-	const auto f = const_cast<TGroundAwareOptions&>(groundOptions).fields();
-	out << uint32_t(f.size());
-	for (const auto& fl : f)
-		out << fl.key << std::visit([](auto* p) { return double(*p); }, fl.var);
+	gam::ini::writeFields(const_cast<TGroundAwareOptions&>(groundOptions).fields(), out);
 }
 
 void CGroundAwareOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version)
@@ -469,27 +449,7 @@ void CGroundAwareOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in,
 			uint8_t baseVer;
 			in >> baseVer;
 			COccupancyGridMap2D::serializeFrom(in, baseVer);
-			auto f = groundOptions.fields();
-			uint32_t n;
-			in >> n;
-			if (n > 10000) throw std::runtime_error("CGroundAwareOccupancyGrid: corrupt stream");
-			for (uint32_t i = 0; i < n; i++)
-			{
-				std::string key;
-				double v;
-				in >> key >> v;
-				for (auto& fl : f)
-					if (fl.key == key)
-						std::visit(
-							[v](auto* p) {
-								using T = std::remove_pointer_t<decltype(p)>;
-								if constexpr (std::is_same_v<T, bool>)
-									*p = v != 0;
-								else
-									*p = T(v);
-							},
-							fl.var);
-			}
+			gam::ini::readFields(groundOptions.fields(), in, "CGroundAwareOccupancyGrid");
 		}
 		break;
 		default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);

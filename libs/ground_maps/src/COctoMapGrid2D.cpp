@@ -23,16 +23,7 @@ void COctoMapGrid2D::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
 {
 	const std::string sC = sectionNamePrefix + "_creationOpts";
-	gam::ini::Fields f = {
-		{"min_x", &min_x, -1e5, 1e5, "grid left edge [m]"},
-		{"max_x", &max_x, -1e5, 1e5, "grid right edge [m]"},
-		{"min_y", &min_y, -1e5, 1e5, "grid bottom edge [m]"},
-		{"max_y", &max_y, -1e5, 1e5, "grid top edge [m]"},
-		{"resolution", &resolution, 1e-3, 100, "2D cell size [m]"}};
-	gam::ini::load(f, source, sC);
-	if (!(min_x < max_x) || !(min_y < max_y))
-		throw std::invalid_argument("[" + sC + "] needs min_x < max_x and min_y < max_y");
-	gam::mrpt_glue::checkGridSize("[" + sC + "]", min_x, max_x, min_y, max_y, resolution);
+	gam::ini::loadGridExtent(source, sC, min_x, max_x, min_y, max_y, resolution);
 	octoOpts.loadFromConfigFile(source, sectionNamePrefix + "_octoOpts");
 }
 
@@ -73,15 +64,7 @@ gam::ini::Fields COctoMapGrid2D::TOctoOptions::fields()
 void COctoMapGrid2D::TOctoOptions::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& source, const std::string& section)
 {
-	gam::ini::load(fields(), source, section);
-	try
-	{
-		validate();
-	}
-	catch (const std::invalid_argument& e)
-	{
-		throw std::invalid_argument("[" + section + "] " + e.what());
-	}
+	gam::ini::loadThenCheck(fields(), source, section, [this] { validate(); });
 }
 
 void COctoMapGrid2D::TOctoOptions::saveToConfigFile(
@@ -225,7 +208,10 @@ void COctoMapGrid2D::updateProjection()
 	const auto t0 = std::chrono::steady_clock::now();
 	m_sinceProjection = 0;
 	m_dirty = false;
-	mrpt::opengl::COctoMapVoxels vox;
+	// On the heap: COctoMapVoxels is over-aligned (32 bytes, Eigen members) and a
+	// stack instance is not always aligned (UBSan: misaligned member call).
+	const auto voxPtr = mrpt::opengl::COctoMapVoxels::Create();
+	auto& vox = *voxPtr;
 	m_octomap.renderingOptions.generateFreeVoxels = octoOptions.mark_free;
 	m_octomap.getAsOctoMapVoxels(vox);
 	const double zlo = octoOptions.z_min, zhi = octoOptions.z_max;
@@ -317,9 +303,7 @@ void COctoMapGrid2D::serializeTo(mrpt::serialization::CArchive& out) const
 	if (m_dirty) const_cast<COctoMapGrid2D*>(this)->updateProjection();
 	out << COccupancyGridMap2D::serializeGetVersion();
 	COccupancyGridMap2D::serializeTo(out);
-	const auto f = const_cast<TOctoOptions&>(octoOptions).fields();
-	out << uint32_t(f.size());
-	for (const auto& fl : f) out << fl.key << std::visit([](auto* p) { return double(*p); }, fl.var);
+	gam::ini::writeFields(const_cast<TOctoOptions&>(octoOptions).fields(), out);
 	out << m_octomap;
 }
 
@@ -332,27 +316,7 @@ void COctoMapGrid2D::serializeFrom(mrpt::serialization::CArchive& in, uint8_t ve
 			uint8_t baseVer;
 			in >> baseVer;
 			COccupancyGridMap2D::serializeFrom(in, baseVer);
-			auto f = octoOptions.fields();
-			uint32_t n;
-			in >> n;
-			if (n > 10000) throw std::runtime_error("COctoMapGrid2D: corrupt stream");
-			for (uint32_t i = 0; i < n; i++)
-			{
-				std::string key;
-				double v;
-				in >> key >> v;
-				for (auto& fl : f)
-					if (fl.key == key)
-						std::visit(
-							[v](auto* p) {
-								using T = std::remove_pointer_t<decltype(p)>;
-								if constexpr (std::is_same_v<T, bool>)
-									*p = v != 0;
-								else
-									*p = T(v);
-							},
-							fl.var);
-			}
+			gam::ini::readFields(octoOptions.fields(), in, "COctoMapGrid2D");
 			in >> m_octomap;
 			m_dirty = false;
 			m_sinceProjection = 0;

@@ -1,4 +1,5 @@
 #include <mrpt/maps/gam_ini_fields.h>
+#include <mrpt/maps/gam_observation_adapters.h>
 
 #include <algorithm>
 #include <cctype>
@@ -113,6 +114,74 @@ void save(const Fields& fields, mrpt::config::CConfigFileBase& dst, const std::s
 void validate(const Fields& fields, const std::string& context)
 {
 	for (const Field& fl : fields) check(fl, context, "");
+}
+
+void loadThenCheck(
+	const Fields& f, const mrpt::config::CConfigFileBase& src, const std::string& section,
+	const std::function<void()>& check)
+{
+	load(f, src, section);
+	try
+	{
+		check();
+	}
+	catch (const std::invalid_argument& e)
+	{
+		throw std::invalid_argument("in section '" + section + "': " + e.what());
+	}
+}
+
+template <typename T>
+void loadGridExtent(
+	const mrpt::config::CConfigFileBase& src, const std::string& section, T& min_x, T& max_x,
+	T& min_y, T& max_y, T& resolution)
+{
+	const Fields f = {
+		{"min_x", &min_x, -1e5, 1e5, "grid left edge [m]"},
+		{"max_x", &max_x, -1e5, 1e5, "grid right edge [m]"},
+		{"min_y", &min_y, -1e5, 1e5, "grid bottom edge [m]"},
+		{"max_y", &max_y, -1e5, 1e5, "grid top edge [m]"},
+		{"resolution", &resolution, 1e-3, 100, "d_r, cell size [m]"}};
+	loadThenCheck(f, src, section, [&] {
+		if (!(min_x < max_x) || !(min_y < max_y))
+			throw std::invalid_argument("needs min_x < max_x and min_y < max_y");
+		gam::mrpt_glue::checkGridSize("the grid", min_x, max_x, min_y, max_y, resolution);
+	});
+}
+template void loadGridExtent<float>(
+	const mrpt::config::CConfigFileBase&, const std::string&, float&, float&, float&, float&, float&);
+template void loadGridExtent<double>(
+	const mrpt::config::CConfigFileBase&, const std::string&, double&, double&, double&, double&,
+	double&);
+
+void writeFields(const Fields& fields, mrpt::serialization::CArchive& out)
+{
+	out << uint32_t(fields.size());
+	for (const Field& fl : fields) out << fl.key << valueOf(fl);
+}
+
+void readFields(const Fields& fields, mrpt::serialization::CArchive& in, const char* who)
+{
+	uint32_t n;
+	in >> n;
+	if (n > 10000) throw std::runtime_error(std::string(who) + ": corrupt stream");
+	for (uint32_t i = 0; i < n; i++)
+	{
+		std::string key;
+		double v;
+		in >> key >> v;
+		for (const Field& fl : fields)
+			if (fl.key == key)
+				std::visit(
+					[v](auto* p) {
+						using T = std::remove_pointer_t<decltype(p)>;
+						if constexpr (std::is_same_v<T, bool>)
+							*p = v != 0;
+						else
+							*p = T(v);
+					},
+					fl.var);
+	}
 }
 
 std::vector<std::string> unknownKeys(

@@ -5,8 +5,10 @@
 #pragma once
 
 #include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -33,6 +35,31 @@ void validate(const Fields& f, const std::string& context);
 /** Keys present in `section` that no field names (typos, misplaced keys). */
 std::vector<std::string> unknownKeys(
 	const Fields& f, const mrpt::config::CConfigFileBase& src, const std::string& section);
+/** load(), then `check` (e.g. the struct's validate(), for rules that involve
+ * several keys); a std::invalid_argument it throws gets the section in front. */
+void loadThenCheck(
+	const Fields& f, const mrpt::config::CConfigFileBase& src, const std::string& section,
+	const std::function<void()>& check);
+
+/** The `_creationOpts` of a 2D grid map: min_x, max_x, min_y, max_y and
+ * resolution, their ranges, min < max, and a cell count that fits in memory. */
+template <typename T>
+void loadGridExtent(
+	const mrpt::config::CConfigFileBase& src, const std::string& section, T& min_x, T& max_x,
+	T& min_y, T& max_y, T& resolution);
+extern template void loadGridExtent<float>(
+	const mrpt::config::CConfigFileBase&, const std::string&, float&, float&, float&, float&, float&);
+extern template void loadGridExtent<double>(
+	const mrpt::config::CConfigFileBase&, const std::string&, double&, double&, double&, double&,
+	double&);
+
+/** Options in a serialized map: a count, then (key, value as double) pairs,
+ * so a file written before an option existed still reads (the option keeps
+ * its default) and unknown keys from newer files are skipped. */
+void writeFields(const Fields& f, mrpt::serialization::CArchive& out);
+/** Throws std::runtime_error ("<who>: corrupt stream") on an absurd count. */
+void readFields(const Fields& f, mrpt::serialization::CArchive& in, const char* who);
+
 /** "key = value  ; help" lines, for --print-config style dumps. */
 std::string describe(const Fields& f);
 
