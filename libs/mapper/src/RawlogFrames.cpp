@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <new>
 #include <stdexcept>
@@ -157,9 +158,34 @@ RawlogFrameReader::RawlogFrameReader(const std::string& path) : m_path(path)
 	if (mrpt::system::directoryExists(imgDir)) mrpt::img::CImage::setImagesPathBase(imgDir);
 }
 
+/** MRPT deserializes a bool by copying the stored byte into it: a corrupt rawlog
+ * leaves values other than 0/1 in bool fields, and reading those is undefined
+ * behaviour (UBSan in tests/fuzz/fuzz_rawlog). Normalize, through bytes, the
+ * flags of the scans the maps read. */
+static void normalizeBools(CObservation& o)
+{
+	auto fix = [](bool& b) {
+		unsigned char r;
+		std::memcpy(&r, &b, 1);
+		r = r != 0;
+		std::memcpy(&b, &r, 1);
+	};
+	if (auto* s3 = dynamic_cast<CObservation3DRangeScan*>(&o))
+	{
+		fix(s3->hasPoints3D);
+		fix(s3->hasRangeImage);
+		fix(s3->range_is_depth);
+		fix(s3->hasIntensityImage);
+		fix(s3->hasConfidenceImage);
+	}
+	else if (auto* s2 = dynamic_cast<CObservation2DRangeScan*>(&o))
+		fix(s2->rightToLeft);
+}
+
 void RawlogFrameReader::handleObservation(const CObservation::Ptr& o)
 {
 	if (!o) return;
+	normalizeBools(*o);
 	if (auto odo = std::dynamic_pointer_cast<CObservationOdometry>(o))
 	{
 		m_pose = mrpt::poses::CPose3D(odo->odometry);
