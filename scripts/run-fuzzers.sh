@@ -42,17 +42,26 @@ mkdir -p "$build/artifacts"
 # GAM_FUZZ_STOP_ON_OOM=1. Crashes, sanitizer reports, leaks and timeouts always stop.
 oom_flags="-fork=1 -ignore_ooms=1"
 [ "${GAM_FUZZ_STOP_ON_OOM:-0}" = 1 ] && oom_flags=""
+# Smoke mode (CI): GAM_FUZZ_RUNS=N runs at most N inputs per target (and at most
+# SECONDS), in one process, from the seeds alone (a fresh corpus folder), with the
+# fixed seed: the same inputs on every machine, so a passing smoke passes everywhere.
+runs_flags=""
+if [ -n "${GAM_FUZZ_RUNS:-}" ]; then
+  runs_flags="-runs=$GAM_FUZZ_RUNS"
+  oom_flags=""
+fi
 status=0
 for t in ${GAM_FUZZ_TARGETS:-fuzz_rawlog fuzz_ini}; do
   seeds="$here/tests/fuzz/corpus/${t#fuzz_}"
   work="$build/corpus/$t"
+  [ -n "$runs_flags" ] && { work="$build/corpus-smoke/$t"; rm -rf "$work"; }
   mkdir -p "$work"
   echo "== $t: ${secs} s, seeds $(ls "$seeds" | wc -l) files, corpus $work"
   log="$build/$t.log"
   # shellcheck disable=SC2086
   if "$build/bin/$t" -max_total_time="$secs" -timeout=20 -rss_limit_mb=3072 -malloc_limit_mb=1100 \
       -max_len=65536 -print_final_stats=1 -artifact_prefix="$build/artifacts/$t-" \
-      -seed="${GAM_FUZZ_SEED:-1}" $oom_flags "$work" "$seeds" >"$log" 2>&1; then
+      -seed="${GAM_FUZZ_SEED:-1}" $oom_flags $runs_flags "$work" "$seeds" >"$log" 2>&1; then
     grep -E "^stat::number_of_executed_units|^stat::new_units_added|^#[0-9]+.*DONE|oom/timeout/crash" "$log" | tail -3 || true
     echo "== $t: no crash ($(ls "$work" | wc -l) corpus files)"
   else
