@@ -34,7 +34,12 @@ class ReactiveNav : public ::testing::Test
 	{
 		gam::nav::ReactiveOptions o;
 		o.cacheDir = cacheDir;
-		return gam::nav::runReactiveNavigation(g, {0, 0, 0}, {4.5, 0}, o);
+		// The straight line from (0, 0.4) to the goal still crosses the hatch
+		// (y = 0.20 .. 0.15 over x = 2.2 .. 2.8). Starting dead on its axis, MRPT's
+		// PTG navigator can stall facing the hatch corner (a local minimum of the
+		// reactive method, not a map error): seen once the map marked the corner
+		// cells the hatch really has.
+		return gam::nav::runReactiveNavigation(g, {0, 0.4, 0}, {4.5, 0}, o);
 	}
 	static double closestToHole(const gam::nav::ReactiveResult& r)
 	{

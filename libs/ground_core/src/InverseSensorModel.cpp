@@ -28,6 +28,7 @@ void IsmParams::validate() const
 	require(K_n > 0, "K_n", "> 0", K_n);
 	require(std::isfinite(d_min), "d_min", "finite", d_min);
 	require(K_m >= 0 && K_m < 1, "K_m", "in [0, 1)", K_m);
+	require(floor_noise_min_cells >= 1, "floor_noise_min_cells", ">= 1", floor_noise_min_cells);
 	require(depth_noise_c0 >= 0, "depth_noise_c0", ">= 0 m", depth_noise_c0);
 	require(depth_noise_c2 >= 0, "depth_noise_c2", ">= 0 1/m", depth_noise_c2);
 	require(noise_sigmas >= 0 && noise_sigmas <= 10, "noise_sigmas", "in [0, 10]", noise_sigmas);
@@ -64,9 +65,48 @@ double InverseSensorModel::groundBand(
 	const double dx = x - sensor.x(), dy = y - sensor.y(), dz = z - sensor.z();
 	const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
 	if (r < 1e-3) return m_params.d_pth;
+	// The floor's vertical scatter measured in this frame at this range, if
+	// enough floor was seen there; else the sensor model.
+	const size_t bin = size_t(r / kNoiseBin);
+	if (bin < m_floorNoise.size() && m_floorNoise[bin] >= 0)
+		return m_params.d_pth + m_params.noise_sigmas * double(m_floorNoise[bin]);
 	const double sd = m_params.depth_noise_c0 + m_params.depth_noise_c2 * r * r;
 	const double sinElev = std::clamp(std::abs(h) / r, 0.0, 1.0);
 	return m_params.d_pth + m_params.noise_sigmas * sd * sinElev;
+}
+
+void InverseSensorModel::measureFloorNoise(
+	const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor)
+{
+	// Floor cells (mean within d_pth of the ground, a few samples) hold the
+	// vertical scatter of the sensor at their range: their sample std. The
+	// median per range bin is robust to the odd obstacle cell among them.
+	const GridGeometry& g = frame.geometry();
+	const size_t nb = size_t(std::ceil((m_params.max_range + 1.0) / kNoiseBin));
+	m_floorNoise.assign(nb, -1.f);
+	if (!m_params.measure_floor_noise || m_params.noise_sigmas <= 0) return;
+	m_noiseSamples.resize(nb);
+	for (auto& v : m_noiseSamples) v.clear();
+	for (uint32_t idx : frame.observedCells())
+	{
+		const ElevationCell& c = frame.cell(idx);
+		if (c.count < 4) continue;
+		const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
+		const double x = g.cx(cx), y = g.cy(cy);
+		const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
+		const Plane& pl = choosePlane(det, c, x, y, block);
+		if (std::abs(pl.signedDistance(x, y, c.mean())) > m_params.d_pth) continue;
+		const Eigen::Vector3d d(x - sensor.x(), y - sensor.y(), c.mean() - sensor.z());
+		const size_t bin = size_t(d.norm() / kNoiseBin);
+		if (bin < nb) m_noiseSamples[bin].push_back(std::sqrt(c.variance()));
+	}
+	for (size_t b = 0; b < nb; b++)
+	{
+		auto& v = m_noiseSamples[b];
+		if (v.size() < size_t(std::max(1, m_params.floor_noise_min_cells))) continue;
+		std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+		m_floorNoise[b] = v[v.size() / 2];
+	}
 }
 
 VoxelClass InverseSensorModel::classify(
@@ -163,6 +203,7 @@ void InverseSensorModel::compute(
 	stats.applied = true;
 
 	buildSupport(g, det);
+	measureFloorNoise(frame, det, sensor);
 	const double maxR2 = m_params.max_range * m_params.max_range;
 	const double res = g.resolution;
 

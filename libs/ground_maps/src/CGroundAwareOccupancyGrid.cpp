@@ -101,6 +101,8 @@ gam::ini::Fields CGroundAwareOccupancyGrid::TGroundAwareOptions::fields()
 		{"depth_noise_c2", &depth_noise_c2, 0, 1, "c2 [1/m]"},
 		{"noise_sigmas", &noise_sigmas, 0, 10, "ground band = d_pth + noise_sigmas * vertical noise; 0 = fixed d_pth"},
 		{"min_obstacle_points", &min_obstacle_points, 1, 1000000, "obstacle/drop voxels with fewer samples are ignored (depth spikes)"},
+		{"measure_floor_noise", &measure_floor_noise, 0, 1, "band from the floor's scatter measured in each frame (model where too little floor)"},
+		{"floor_noise_min_cells", &floor_noise_min_cells, 1, 1000000, "floor cells a 0.5 m range bin needs to be measured"},
 		{"robot_height", &robot_height, 1e-3, 100, "voxels entirely above this do not block [m]"},
 		{"drop_rays", &drop_rays, 0, 1, "mark cells where rays went below the ground"},
 		{"max_drop_ray_length", &max_drop_ray_length, 0, 100, "longest drop ray [m]"},
@@ -184,6 +186,8 @@ gam::IsmParams CGroundAwareOccupancyGrid::TGroundAwareOptions::ismParams() const
 	p.depth_noise_c0 = depth_noise_c0;
 	p.depth_noise_c2 = depth_noise_c2;
 	p.noise_sigmas = noise_sigmas;
+	p.measure_floor_noise = measure_floor_noise;
+	p.floor_noise_min_cells = floor_noise_min_cells;
 	p.min_obstacle_points = min_obstacle_points;
 	p.robot_height = robot_height;
 	p.max_range = max_range;

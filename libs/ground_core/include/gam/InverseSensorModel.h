@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -30,6 +31,13 @@ struct IsmParams
 	double depth_noise_c0 = 0.0012;
 	double depth_noise_c2 = 0.0019;
 	double noise_sigmas = 3.0;	///< 0 = the paper's fixed d_pth
+	/** Measure the floor's vertical scatter in each frame instead: the median
+	 * sample std of the floor cells in 0.5 m range bins (bins with at least
+	 * floor_noise_min_cells such cells; the model above fills the others). A
+	 * Kinect One, a Kinect v1 at 5 m or a stereo camera then each get the band
+	 * their own noise needs, with no per-sensor tuning. */
+	bool measure_floor_noise = true;
+	int floor_noise_min_cells = 10;
 	/** Obstacle and drop voxels with fewer samples give no evidence. Any real
 	 * surface within a depth camera's range fills a d_r cell with several
 	 * samples (a 5 cm cell of floor 4.5 m away from a 512x424 Kinect One
@@ -118,13 +126,20 @@ class InverseSensorModel
 	/** Classification of one voxel against one plane (exposed for tests). */
 	VoxelClass classify(
 		const ElevationCell& c, double x, double y, const Plane& pl, double band, double& dMean) const;
-	/** Half-width of the ground band for a voxel at (x, y, z) seen from `sensor`. */
+	/** Half-width of the ground band for a voxel at (x, y, z) seen from `sensor`
+	 * (h: sensor height over the plane): d_pth + noise_sigmas * the floor's
+	 * vertical noise at that range, measured in the last compute() or modelled. */
 	double groundBand(const Eigen::Vector3d& sensor, double sensorHeight, double x, double y, double z) const;
 
    private:
 	void put(uint32_t cell, float p);
 	const Plane& choosePlane(const GroundDetection& det, const ElevationCell& c, double x, double y, int block) const;
 	void buildSupport(const GridGeometry& g, const GroundDetection& det);
+	void measureFloorNoise(const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor);
+
+	static constexpr double kNoiseBin = 0.5;  ///< range bin of the floor noise [m]
+	std::vector<float> m_floorNoise;  ///< per bin: measured std [m], < 0 = not measured
+	std::vector<std::vector<float>> m_noiseSamples;
 
 	IsmParams m_params;
 	std::vector<float> m_evidence;

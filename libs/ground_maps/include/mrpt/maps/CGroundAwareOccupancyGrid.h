@@ -82,6 +82,8 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		// Inverse sensor model
 		double d_pth = 0.03, K_g = 0.3, sigma2 = 0.02, K_n = 0.0005, d_min = 3.0, K_m = 0.8;
 		double depth_noise_c0 = 0.0012, depth_noise_c2 = 0.0019, noise_sigmas = 3.0;
+		bool measure_floor_noise = true;
+		int floor_noise_min_cells = 10;
 		int min_obstacle_points = 2;
 		double robot_height = 1.8;
 		bool drop_rays = true;
