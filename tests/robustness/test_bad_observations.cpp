@@ -373,3 +373,37 @@ TEST(RobustObservations, EmptyAndDegenerate2DScans)
 		}
 	}
 }
+
+TEST(RobustObservations, HugeValid2DRangesGiveAClearErrorNotAHeapOverflow)
+{
+	// Found by tests/fuzz/fuzz_rawlog: a scan whose maxRange and one valid range are
+	// 1e30 m made MRPT's beam model grow the grid with overflowing 32-bit sizes (heap
+	// overflow in COccupancyGridMap2D::resizeGrid).
+	for (float maxRange : {1e30f, 0.f})
+	{
+		mrpt::obs::CObservation2DRangeScan s;
+		s.aperture = float(M_PI);
+		s.maxRange = maxRange;
+		s.resizeScan(16);
+		for (size_t i = 0; i < 16; i++)
+		{
+			s.setScanRange(i, i == 3 ? 1e30f : 2.0f);
+			s.setScanRangeValidity(i, true);
+		}
+		for (auto& m : allMaps())
+		{
+			auto* g = dynamic_cast<COccupancyGridMap2D*>(m.map.get());
+			if (!g || dynamic_cast<COctoMapGrid2D*>(g)) continue;  // the octomap clips rays itself
+			try
+			{
+				m.map->insertObservation(s);
+				ADD_FAILURE() << m.name << " accepted a 1e30 m range";
+			}
+			catch (const std::exception& e)
+			{
+				EXPECT_NE(std::string(e.what()).find("too large"), std::string::npos) << m.name << ": " << e.what();
+			}
+			EXPECT_LE(size_t(g->getSizeX()) * g->getSizeY(), size_t(1) << 28) << m.name;
+		}
+	}
+}

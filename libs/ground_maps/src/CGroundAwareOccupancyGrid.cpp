@@ -271,9 +271,9 @@ bool CGroundAwareOccupancyGrid::internal_insertObservation(
 }
 
 bool CGroundAwareOccupancyGrid::insert2D(
-	const mrpt::obs::CObservation2DRangeScan& scan, const std::optional<const mrpt::poses::CPose3D>& robotPose)
+	const mrpt::obs::CObservation2DRangeScan& rawScan, const std::optional<const mrpt::poses::CPose3D>& robotPose)
 {
-	gam::mrpt_glue::checkScanGrowth(*this, (robotPose ? *robotPose : mrpt::poses::CPose3D()) + scan.sensorPose);
+	const auto scan = gam::mrpt_glue::safeScanFor(*this, rawScan, robotPose ? *robotPose : mrpt::poses::CPose3D());
 	const bool sparse = int(scan.getScanSize()) < 64 && groundOptions.sparse_scan_upsampling > 1;
 	const auto up = sparse ? upsampleSparseScan(scan, groundOptions.sparse_scan_upsampling)
 						   : mrpt::obs::CObservation2DRangeScan();

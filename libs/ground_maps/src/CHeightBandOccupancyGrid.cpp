@@ -119,10 +119,11 @@ bool CHeightBandOccupancyGrid::internal_insertObservation(
 		o3.convertTo2DScan(m_lastScan, sp);
 		m_hasLastScan = true;
 		if (m_lastScan.getScanSize() == 0) return false;
+		m_lastScan = gam::mrpt_glue::safeScanFor(*this, m_lastScan, pose);
 		return COccupancyGridMap2D::internal_insertObservation(m_lastScan, robotPose);
 	}
 	if (const auto* o2 = dynamic_cast<const CObservation2DRangeScan*>(&obs))
-		gam::mrpt_glue::checkScanGrowth(*this, pose + o2->sensorPose);
+		return COccupancyGridMap2D::internal_insertObservation(gam::mrpt_glue::safeScanFor(*this, *o2, pose), robotPose);
 	return COccupancyGridMap2D::internal_insertObservation(obs, robotPose);
 }
 

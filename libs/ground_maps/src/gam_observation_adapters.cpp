@@ -193,14 +193,37 @@ void checkGridSize(const std::string& what, double x0, double x1, double y0, dou
 	}
 }
 
-void checkScanGrowth(const mrpt::maps::COccupancyGridMap2D& g, const mrpt::poses::CPose3D& sensorInMap)
+void checkScanGrowth(
+	const mrpt::maps::COccupancyGridMap2D& g, const mrpt::poses::CPose3D& sensorInMap, double farthestRange)
 {
 	if (!finitePose(sensorInMap)) throw std::invalid_argument("robot or sensor pose is not finite");
-	const double reach = std::max(0.0, double(g.insertionOptions.maxDistanceInsertion)) + 1.0;
+	const double reach =
+		std::max({0.0, double(g.insertionOptions.maxDistanceInsertion), farthestRange}) + 1.0;
 	const double x = sensorInMap.x(), y = sensorInMap.y();
 	checkGridSize(
 		"growing the grid to the scan", std::min<double>(g.getXMin(), x - reach), std::max<double>(g.getXMax(), x + reach),
 		std::min<double>(g.getYMin(), y - reach), std::max<double>(g.getYMax(), y + reach), g.getResolution());
+}
+
+mrpt::obs::CObservation2DRangeScan safeScanFor(
+	const mrpt::maps::COccupancyGridMap2D& g, const mrpt::obs::CObservation2DRangeScan& in,
+	const mrpt::poses::CPose3D& robotPose)
+{
+	if (!std::isfinite(in.aperture) || !std::isfinite(in.maxRange))
+		throw std::invalid_argument("CObservation2DRangeScan aperture or maxRange is not finite");
+	mrpt::obs::CObservation2DRangeScan out = in;
+	double farthest = 0;
+	for (size_t i = 0; i < out.getScanSize(); i++)
+	{
+		if (!out.getScanRangeValidity(i)) continue;
+		const float r = out.getScanRange(i);
+		if (!std::isfinite(r) || !(r > 0) || (in.maxRange > 0 && r > in.maxRange))
+			out.setScanRangeValidity(i, false);
+		else
+			farthest = std::max(farthest, double(r));
+	}
+	checkScanGrowth(g, robotPose + in.sensorPose, farthest);
+	return out;
 }
 
 }  // namespace gam::mrpt_glue

@@ -65,6 +65,17 @@ void checkGridSize(const std::string& what, double x0, double x1, double y0, dou
  * (it grows the grid to hold the rays, up to insertionOptions.maxDistanceInsertion):
  * throws std::invalid_argument if the pose is not finite or if the grown grid would
  * exceed kMaxGridCells (a robot pose far from everything seen so far). */
-void checkScanGrowth(const mrpt::maps::COccupancyGridMap2D& g, const mrpt::poses::CPose3D& sensorInMap);
+void checkScanGrowth(
+	const mrpt::maps::COccupancyGridMap2D& g, const mrpt::poses::CPose3D& sensorInMap, double farthestRange = 0);
+
+/** A copy of `in` that MRPT's beam model can take safely (it grows the grid to
+ * every valid range, computing the new size in 32-bit ints: a 1e30 m range became
+ * a heap overflow in resizeGrid(), found by tests/fuzz/fuzz_rawlog): ranges that
+ * are not finite, <= 0 or beyond the scan's maxRange are marked invalid, and the
+ * growth to the farthest remaining one is checked (checkScanGrowth). Throws
+ * std::invalid_argument for a non-finite aperture or maxRange, or a too large grid. */
+mrpt::obs::CObservation2DRangeScan safeScanFor(
+	const mrpt::maps::COccupancyGridMap2D& g, const mrpt::obs::CObservation2DRangeScan& in,
+	const mrpt::poses::CPose3D& robotPose);
 
 }  // namespace gam::mrpt_glue
