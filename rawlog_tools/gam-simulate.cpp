@@ -24,6 +24,7 @@
 
 #include "gam/sim/GroundTruth.h"
 #include "gam/sim/SceneFile.h"
+#include "gam/sim/KinectObservation.h"
 #include "gam/sim/Sensors.h"
 
 using namespace gam::sim;
@@ -192,29 +193,10 @@ int main(int argc, char** argv)
 			}
 			const DepthFrame fr = kinect.render(sf.scene, robot * sf.kinect_pose * sway, rngKinect);
 			gt.markObserved(fr.footprint);
-			auto k = mrpt::obs::CObservation3DRangeScan::Create();
-			k->sensorLabel = "KINECT";
+			size_t frameValid = 0;
+			auto k = toKinectObservation(sf.kinect, fr, kinPose, &frameValid);
 			k->timestamp = ts;
-			k->hasRangeImage = true;
-			k->range_is_depth = true;
-			k->rangeUnits = 0.001f;
-			k->maxRange = float(sf.kinect.max_range);
-			k->stdError = float(sf.kinect.sigma(2.0, 0.0));
-			k->sensorPose = kinPose;
-			k->cameraParams.ncols = uint32_t(fr.width);
-			k->cameraParams.nrows = uint32_t(fr.height);
-			k->cameraParams.setIntrinsicParamsFromValues(
-				sf.kinect.fx(), sf.kinect.fy(), sf.kinect.cx(), sf.kinect.cy());
-			k->cameraParamsIntensity = k->cameraParams;
-			k->rangeImage_setSize(fr.height, fr.width);
-			for (int r = 0; r < fr.height; r++)
-				for (int c = 0; c < fr.width; c++)
-				{
-					const float d = fr.depth[fr.idx(r, c)];
-					const long u = d > 0 ? std::lround(d / 0.001) : 0;
-					k->rangeImage(r, c) = uint16_t(std::clamp(u, 0L, 65535L));
-					validPix += u > 0;
-				}
+			validPix += frameValid;
 			ar << *k;
 			if (argDepthPgm.getValue())
 			{

@@ -16,6 +16,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "gam/sim/KinectObservation.h"
 #include "gam/sim/Sensors.h"
 
 namespace gam::nav
@@ -37,28 +38,7 @@ mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
 		gam::sim::Pose3::fromXYZYPR(robot.x, robot.y, 0, robot.yaw, 0, 0);
 	const gam::sim::DepthFrame fr = kinect.render(sf.scene, robot3 * sf.kinect_pose, rng);
 
-	auto k = mrpt::obs::CObservation3DRangeScan::Create();
-	k->sensorLabel = "KINECT";
-	k->hasRangeImage = true;
-	k->range_is_depth = true;
-	k->rangeUnits = 0.001f;
-	k->maxRange = float(sf.kinect.max_range);
-	k->stdError = float(sf.kinect.sigma(2.0, 0.0));
-	k->sensorPose = toCPose3D(sf.kinect_pose);
-	k->cameraParams.ncols = uint32_t(fr.width);
-	k->cameraParams.nrows = uint32_t(fr.height);
-	k->cameraParams.setIntrinsicParamsFromValues(
-		sf.kinect.fx(), sf.kinect.fy(), sf.kinect.cx(), sf.kinect.cy());
-	k->cameraParamsIntensity = k->cameraParams;
-	k->rangeImage_setSize(fr.height, fr.width);
-	for (int r = 0; r < fr.height; r++)
-		for (int c = 0; c < fr.width; c++)
-		{
-			const float d = fr.depth[fr.idx(r, c)];
-			const long u = d > 0 ? std::lround(d / 0.001) : 0;
-			k->rangeImage(r, c) = uint16_t(std::clamp(u, 0L, 65535L));
-		}
-	return k;
+	return gam::sim::toKinectObservation(sf.kinect, fr, toCPose3D(sf.kinect_pose));
 }
 
 void buildMaps(const gam::sim::SceneFile& sfIn, const MapOptions& opts, NavMaps& out)
