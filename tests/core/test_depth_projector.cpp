@@ -109,8 +109,8 @@ void checkPixelsOneByOne(
 			const double v = raw * 0.001;
 			const double D = isDepth ? v : v / ray.norm();
 			const Eigen::Vector3d P = R * (D * ray) + t;
-			expectInCell(grid.geometry(), out.cell[0], P.x(), P.y());
-			EXPECT_NEAR(out.z[0], P.z(), 1e-4) << r << "," << c;
+			expectInCell(grid.geometry(), out.cells()[0], P.x(), P.y());
+			EXPECT_NEAR(out.heights()[0], P.z(), 1e-4) << r << "," << c;
 			++*checked;
 		}
 }
@@ -136,11 +136,11 @@ TEST(DepthProjector, RayLutFollowsMrptConvention)
 	BinnedPoints out;
 	Image img;
 	proj.project(img.view(), K, RigidTransform{}, ProjectionFilter{}, grid, out);
-	ASSERT_EQ(proj.rayLut().size(), size_t(W * H));
+	ASSERT_EQ(proj.rayTableSize(), size_t(W * H));
 	for (int r : {0, 10, 47})
 		for (int c : {0, 31, 63})
 		{
-			const auto& k = proj.rayLut()[size_t(r) * W + size_t(c)];
+			const Eigen::Vector2f k = proj.rayFactor(r, c);
 			EXPECT_NEAR(k.x(), (31.5 - c) / 50.0, 1e-6);
 			EXPECT_NEAR(k.y(), (23.5 - r) / 50.0, 1e-6);
 		}
@@ -166,9 +166,9 @@ TEST(DepthProjector, WallAtThreeMetresLandsInItsColumn)
 	double zmin = 1e9, zmax = -1e9;
 	for (size_t i = 0; i < out.size(); i++)
 	{
-		EXPECT_EQ(int(out.cell[i] % 200u), col);
-		zmin = std::min(zmin, double(out.z[i]));
-		zmax = std::max(zmax, double(out.z[i]));
+		EXPECT_EQ(int(out.cells()[i] % 200u), col);
+		zmin = std::min(zmin, double(out.heights()[i]));
+		zmax = std::max(zmax, double(out.heights()[i]));
 	}
 	// Heights of the top and bottom rows: 0.5 + 3.02 * (23.5 - r) / 50.
 	EXPECT_NEAR(zmax, 0.5 + 3.02 * 23.5 / 50, 1e-4);
@@ -212,14 +212,14 @@ TEST(DepthProjector, YawedSensorSeesWallInItsRow)
 	DepthProjector proj;
 	BinnedPoints out;
 	EXPECT_EQ(proj.project(img.view(), camera(), T, ProjectionFilter{}, grid, out), size_t(W * H));
-	for (size_t i = 0; i < out.size(); i++) EXPECT_EQ(int(out.cell[i] / 200u), 180);
+	for (size_t i = 0; i < out.size(); i++) EXPECT_EQ(int(out.cells()[i] / 200u), 180);
 	// Pixel column 0 looks left of the optical axis: +Y of the sensor = -X of
 	// the grid, so x = 1 - 2.02 * 31.5 / 50.
 	Image one;
 	one.at(23, 0) = toRaw(2.02);
 	out.clear();
 	ASSERT_EQ(proj.project(one.view(), camera(), T, ProjectionFilter{}, grid, out), 1u);
-	expectInCell(grid.geometry(), out.cell[0], 1 - 2.02 * 31.5 / 50, 4.02);
+	expectInCell(grid.geometry(), out.cells()[0], 1 - 2.02 * 31.5 / 50, 4.02);
 	int checked = 0;
 	checkPixelsOneByOne(img, true, T, R, t, grid, &checked);
 	EXPECT_GT(checked, 100);
@@ -251,7 +251,7 @@ TEST(DepthProjector, FloorFromPitchedCameraLandsAtZeroHeight)
 	BinnedPoints out;
 	EXPECT_EQ(proj.project(img.view(), K, T, ProjectionFilter{}, grid, out), size_t(W * H));
 	// Depth quantization is 0.5 mm along X: |dz| <= 0.5 mm * |w.z| / 1 < 1 mm.
-	for (float z : out.z) EXPECT_NEAR(z, 0.0, 1e-3);
+	for (float z : out.heights()) EXPECT_NEAR(z, 0.0, 1e-3);
 	gamtest::insertAll(grid, out);
 	for (uint32_t idx : grid.observedCells()) EXPECT_NEAR(grid.cell(idx).mean(), 0.0, 1e-3);
 	// Nearest floor point: bottom row, centre column.
@@ -284,7 +284,7 @@ TEST(DepthProjector, RangeModeUsesEuclideanRange)
 	ProjectionFilter f;
 	f.max_range = 10;
 	EXPECT_EQ(proj.project(img.view(false), K, T, f, grid, out), size_t(W * H));
-	for (size_t i = 0; i < out.size(); i++) EXPECT_EQ(int(out.cell[i] % 200u), 160);
+	for (size_t i = 0; i < out.size(); i++) EXPECT_EQ(int(out.cells()[i] % 200u), 160);
 	int checked = 0;
 	checkPixelsOneByOne(img, false, T, R, t, grid, &checked);
 	EXPECT_GT(checked, 100);
@@ -295,7 +295,7 @@ TEST(DepthProjector, RangeModeUsesEuclideanRange)
 	out.clear();
 	ASSERT_EQ(proj.project(one.view(true), K, T, f, grid, out), 1u);
 	const double xr = 3.02 * pixelRay(K, 0, 0).norm();	// 3.84 m
-	EXPECT_EQ(int(out.cell[0] % 200u), int(std::floor((xr + 5) / 0.05)));
+	EXPECT_EQ(int(out.cells()[0] % 200u), int(std::floor((xr + 5) / 0.05)));
 
 	// Range limits apply to the range along the ray in this mode: a wall at
 	// x = 3.5 has ranges 3.5 |ray| in [3.5, 4.55]; max_range 4 keeps the pixels
@@ -328,7 +328,7 @@ TEST(DepthProjector, DecimationUsesEveryNthRowAndColumn)
 	f.decimation = 2;
 	EXPECT_EQ(proj.project(img.view(), camera(), T, f, grid, out), size_t(24 * 32));
 	// Only even rows: z = 0.5 + 3.02 * (23.5 - r) / 50 with r even.
-	for (float z : out.z)
+	for (float z : out.heights())
 	{
 		const double r = 23.5 - (z - 0.5) * 50 / 3.02;
 		const double nearest = std::round(r);
@@ -373,7 +373,7 @@ TEST(DepthProjector, HeightBandAndRangeLimits)
 	f.z_min = 0.0f;
 	f.z_max = 1.0f;
 	EXPECT_EQ(proj.project(wall.view(), camera(), T, f, grid, out), rowsIn * W);
-	for (float z : out.z)
+	for (float z : out.heights())
 	{
 		EXPECT_GE(z, 0.f);
 		EXPECT_LE(z, 1.f);
@@ -387,12 +387,12 @@ TEST(DepthProjector, HeightBandAndRangeLimits)
 	g.max_range = 4.0f;
 	out.clear();
 	EXPECT_EQ(proj.project(img.view(), camera(), T, g, grid, out), size_t(32 * H));
-	for (uint32_t idx : out.cell) EXPECT_EQ(int(idx % 200u), int(std::floor((2.0 + 5) / 0.05)));
+	for (uint32_t idx : out.cells()) EXPECT_EQ(int(idx % 200u), int(std::floor((2.0 + 5) / 0.05)));
 	g.max_range = 5.0f;
 	g.min_range = 3.0f;
 	out.clear();
 	EXPECT_EQ(proj.project(img.view(), camera(), T, g, grid, out), size_t(32 * H));
-	for (uint32_t idx : out.cell) EXPECT_EQ(int(idx % 200u), int(std::floor((4.5 + 5) / 0.05)));
+	for (uint32_t idx : out.cells()) EXPECT_EQ(int(idx % 200u), int(std::floor((4.5 + 5) / 0.05)));
 	g.min_range = 0;
 	out.clear();
 	EXPECT_EQ(proj.project(img.view(), camera(), T, g, grid, out), size_t(W * H));
@@ -430,7 +430,7 @@ TEST(DepthProjector, InvalidPixelsAndOutOfGridPointsAreSkipped)
 	ElevationGrid beforeWall(makeGeometry(3.0, -5, 0.05, 20, 200));
 	out.clear();
 	EXPECT_EQ(proj.project(wall.view(), camera(), T, ProjectionFilter{}, beforeWall, out), size_t(W * H));
-	for (uint32_t idx : out.cell) EXPECT_EQ(idx % 20u, 0u);
+	for (uint32_t idx : out.cells()) EXPECT_EQ(idx % 20u, 0u);
 
 	// Row padding (stride > cols) is never read, even if it holds values.
 	Image padded(H, W, W + 5);
@@ -438,7 +438,7 @@ TEST(DepthProjector, InvalidPixelsAndOutOfGridPointsAreSkipped)
 		for (int c = 0; c < W + 5; c++) padded.at(r, c) = c < W ? 3020 : 1000;
 	out.clear();
 	EXPECT_EQ(proj.project(padded.view(), camera(), T, ProjectionFilter{}, grid, out), size_t(W * H));
-	for (uint32_t idx : out.cell) EXPECT_EQ(int(idx % 200u), 160);
+	for (uint32_t idx : out.cells()) EXPECT_EQ(int(idx % 200u), 160);
 
 	// project() appends.
 	const size_t before = out.size();
@@ -514,11 +514,11 @@ TEST(DepthProjector, LensDistortionIsInvertedInTheRayTable)
 	BinnedPoints out;
 	Image img;
 	proj.project(img.view(), K, RigidTransform{}, ProjectionFilter{}, grid, out);
-	ASSERT_EQ(proj.rayLut().size(), size_t(W * H));
+	ASSERT_EQ(proj.rayTableSize(), size_t(W * H));
 	for (int r = 0; r < H; r += 7)
 		for (int c = 0; c < W; c += 9)
 		{
-			const auto& k = proj.rayLut()[size_t(r) * W + size_t(c)];
+			const Eigen::Vector2f k = proj.rayFactor(r, c);
 			const double xu = -k.x(), yu = -k.y();
 			const double r2 = xu * xu + yu * yu;
 			const double radial = 1 + K.k1 * r2 + K.k2 * r2 * r2 + K.k3 * r2 * r2 * r2;
@@ -529,14 +529,14 @@ TEST(DepthProjector, LensDistortionIsInvertedInTheRayTable)
 		}
 	// Barrel distortion (k1 > 0): the corner ray is less oblique than the
 	// distorted pixel position says.
-	const auto& corner = proj.rayLut()[0];
+	const Eigen::Vector2f corner = proj.rayFactor(0, 0);
 	EXPECT_LT(std::abs(corner.x()), 31.5 / 50.0);
 	EXPECT_LT(std::abs(corner.y()), 23.5 / 50.0);
 
 	// The table follows the intrinsics: back to no distortion.
 	proj.project(img.view(), camera(), RigidTransform{}, ProjectionFilter{}, grid, out);
-	EXPECT_NEAR(proj.rayLut()[0].x(), 31.5 / 50.0, 1e-6);
-	EXPECT_NEAR(proj.rayLut()[0].y(), 23.5 / 50.0, 1e-6);
+	EXPECT_NEAR(proj.rayFactor(0, 0).x(), 31.5 / 50.0, 1e-6);
+	EXPECT_NEAR(proj.rayFactor(0, 0).y(), 23.5 / 50.0, 1e-6);
 
 	K = camera();
 	K.k1 = NAN;

@@ -54,8 +54,8 @@ TEST(ElevationGrid, BinPointInsideAndOutside)
 	BinnedPoints b;
 	EXPECT_TRUE(grid.binPoint(0.25, 0.31, 1.5f, b));
 	ASSERT_EQ(b.size(), 1u);
-	EXPECT_EQ(b.cell[0], 3u * 10u + 2u);
-	EXPECT_FLOAT_EQ(b.z[0], 1.5f);
+	EXPECT_EQ(b.cells()[0], 3u * 10u + 2u);
+	EXPECT_FLOAT_EQ(b.heights()[0], 1.5f);
 	EXPECT_FALSE(grid.binPoint(-0.01, 0.2, 0.f, b));
 	EXPECT_FALSE(grid.binPoint(1.0, 0.2, 0.f, b));
 	EXPECT_FALSE(grid.binPoint(0.5, 0.5, 0.f, b));

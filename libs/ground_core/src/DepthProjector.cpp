@@ -25,10 +25,14 @@ void PinholeIntrinsics::validate() const
 
 void DepthProjector::updateLut(const PinholeIntrinsics& K)
 {
-	if (K == m_lutK && !m_lut.empty()) return;
+	if (K == m_lutK && !m_rayY.empty()) return;
 	m_lutK = K;
-	m_lut.resize(size_t(K.width) * size_t(K.height));
-	m_lutNorm.resize(m_lut.size());
+	const size_t n = size_t(K.width) * size_t(K.height);
+	m_rayY.resize(n);
+	m_rayZ.resize(n);
+	m_rayInvNorm.resize(n);
+	m_rowCell.resize(size_t(K.width));
+	m_rowZ.resize(size_t(K.width));
 	for (int r = 0; r < K.height; r++)
 		for (int c = 0; c < K.width; c++)
 		{
@@ -56,10 +60,59 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 			}
 			const float ky = float(-xu), kz = float(-yu);
 			const size_t i = size_t(r) * size_t(K.width) + size_t(c);
-			m_lut[i] = {ky, kz};
-			m_lutNorm[i] = std::sqrt(1.0f + ky * ky + kz * kz);
+			m_rayY[i] = ky;
+			m_rayZ[i] = kz;
+			m_rayInvNorm[i] = 1.0f / std::sqrt(1.0f + ky * ky + kz * kz);
 		}
 }
+
+namespace
+{
+// One pixel: its grid cell (-1 if it is dropped) and its height.
+template <bool kDepth>
+inline void projectPixel(
+	const DepthProjector::RowParams& p, uint16_t raw, float ky, float kz, float invNorm, int32_t& cell, float& z)
+{
+	const float v = float(raw) * p.units;  // 0 = no return: fails v > 0 below
+	const float D = kDepth ? v : v * invNorm;
+	// Sensor-frame point (D, D*ky, D*kz) mapped to the grid frame.
+	const float sy = D * ky, sz = D * kz;
+	const float fx = p.rx[0] * D + p.rx[1] * sy + p.rx[2] * sz + p.t[0];	// cells
+	const float fy = p.ry[0] * D + p.ry[1] * sy + p.ry[2] * sz + p.t[1];
+	const float gz = p.rz[0] * D + p.rz[1] * sy + p.rz[2] * sz + p.t[2];	// metres
+	// Written so that NaN fails every comparison.
+	const bool ok = (v > 0.f) & (v >= p.min_range) & (v <= p.max_range) & (gz >= p.z_min) &
+					(gz <= p.z_max) & (fx >= 0.f) & (fy >= 0.f) & (fx < p.nx) & (fy < p.ny);
+	// int() of a value outside the int range is UB: convert only in-grid values.
+	const int32_t cx = int32_t(ok ? fx : 0.f), cy = int32_t(ok ? fy : 0.f);
+	cell = ok ? cy * p.nx_cells + cx : -1;
+	z = gz;
+}
+
+// A full row: no branches and unit strides, so the compiler vectorizes it.
+template <bool kDepth>
+void projectRow(
+	const DepthProjector::RowParams& p, const uint16_t* __restrict row, const float* __restrict ky,
+	const float* __restrict kz, const float* __restrict invNorm, int cols, int32_t* __restrict cell,
+	float* __restrict z)
+{
+	for (int c = 0; c < cols; c++)
+		projectPixel<kDepth>(p, row[c], ky[c], kz[c], kDepth ? 1.f : invNorm[c], cell[c], z[c]);
+}
+
+void projectRowDecimated(
+	const DepthProjector::RowParams& p, bool isDepth, const uint16_t* row, const float* ky, const float* kz,
+	const float* invNorm, int cols, int dec, int32_t* cell, float* z)
+{
+	for (int c = 0, k = 0; c < cols; c += dec, k++)
+	{
+		if (isDepth)
+			projectPixel<true>(p, row[c], ky[c], kz[c], 1.f, cell[k], z[k]);
+		else
+			projectPixel<false>(p, row[c], ky[c], kz[c], invNorm[c], cell[k], z[k]);
+	}
+}
+}  // namespace
 
 size_t DepthProjector::project(
 	const RangeImageView& img, const PinholeIntrinsics& K, const RigidTransform& T,
@@ -79,44 +132,71 @@ size_t DepthProjector::project(
 		throw std::invalid_argument("sensor pose is not finite");
 	updateLut(K);
 
-	const int dec = std::max(1, f.decimation);
+	RowParams p;
 	const GridGeometry& g = grid.geometry();
 	const float inv_res = float(1.0 / g.resolution);
-	// Grid coordinates relative to the grid origin, to keep floats precise.
-	const Eigen::Vector3f t0 = T.t - Eigen::Vector3f(float(g.x_min), float(g.y_min), 0.f);
-	const Eigen::Matrix3f& R = T.R;
-	const float minR = std::max(0.0f, f.min_range), maxR = f.max_range;
-	const bool isDepth = img.is_depth;
-	size_t binned = 0;
+	// Work in cell units relative to the grid origin: floats stay precise far
+	// from the map origin, and the cell index is just the integer part.
+	const Eigen::Matrix3f Rc = T.R * inv_res;
+	const Eigen::Vector3f tc =
+		(T.t - Eigen::Vector3f(float(g.x_min), float(g.y_min), 0.f)) * inv_res;
+	for (int j = 0; j < 3; j++)
+	{
+		p.rx[j] = Rc(0, j);
+		p.ry[j] = Rc(1, j);
+		p.rz[j] = T.R(2, j);
+	}
+	p.t[0] = tc.x();
+	p.t[1] = tc.y();
+	p.t[2] = T.t.z();
+	p.min_range = std::max(0.0f, f.min_range);
+	p.max_range = f.max_range;
+	p.z_min = f.z_min;
+	p.z_max = f.z_max;
+	p.nx = float(g.nx);
+	p.ny = float(g.ny);
+	p.nx_cells = g.nx;
+	p.units = img.units;
+
+	const int dec = std::max(1, f.decimation);
+	const size_t colsUsed = size_t((img.cols + dec - 1) / dec);
+	const size_t rowsUsed = size_t((img.rows + dec - 1) / dec);
+	const size_t start = out.size();
+	out.prepare(colsUsed * rowsUsed);
+	uint32_t* outCell = out.cellBuffer();
+	float* outZ = out.zBuffer();
+	size_t n = start;
+	int32_t* rowCell = m_rowCell.data();
+	float* rowZ = m_rowZ.data();
 
 	for (int r = 0; r < img.rows; r += dec)
 	{
+		const size_t lutRow = size_t(r) * size_t(K.width);
 		const uint16_t* row = img.data + size_t(r) * img.stride;
-		const Eigen::Vector2f* lut = m_lut.data() + size_t(r) * size_t(K.width);
-		const float* lutN = m_lutNorm.data() + size_t(r) * size_t(K.width);
-		for (int c = 0; c < img.cols; c += dec)
+		if (dec == 1)
 		{
-			const uint16_t raw = row[c];
-			if (!raw) continue;
-			const float v = float(raw) * img.units;
-			if (v < minR || v > maxR) continue;
-			const float D = isDepth ? v : v / lutN[c];
-			// Sensor-frame point (D, D*ky, D*kz) mapped to the grid frame.
-			const float sy = D * lut[c].x(), sz = D * lut[c].y();
-			const float gx = R(0, 0) * D + R(0, 1) * sy + R(0, 2) * sz + t0.x();
-			const float gy = R(1, 0) * D + R(1, 1) * sy + R(1, 2) * sz + t0.y();
-			const float gz = R(2, 0) * D + R(2, 1) * sy + R(2, 2) * sz + t0.z();
-			if (gz < f.z_min || gz > f.z_max) continue;
-			const float fx_ = gx * inv_res, fy_ = gy * inv_res;
-			if (!(fx_ >= 0.f) || !(fy_ >= 0.f)) continue;	// also rejects NaN
-			// Compare as floats first: int() of a value beyond the int range is UB.
-			if (fx_ >= float(g.nx) || fy_ >= float(g.ny)) continue;
-			const int cx = int(fx_), cy = int(fy_);
-			if (cx >= g.nx || cy >= g.ny) continue;
-			out.push(uint32_t(cy) * uint32_t(g.nx) + uint32_t(cx), gz);
-			binned++;
+			if (img.is_depth)
+				projectRow<true>(p, row, &m_rayY[lutRow], &m_rayZ[lutRow], nullptr, img.cols, rowCell, rowZ);
+			else
+				projectRow<false>(
+					p, row, &m_rayY[lutRow], &m_rayZ[lutRow], &m_rayInvNorm[lutRow], img.cols, rowCell, rowZ);
+		}
+		else
+			projectRowDecimated(
+				p, img.is_depth, row, &m_rayY[lutRow], &m_rayZ[lutRow], &m_rayInvNorm[lutRow], img.cols, dec,
+				rowCell, rowZ);
+		// Compaction: every pixel is written at outCell[n], only the valid ones
+		// advance n (branch-free: valid and invalid pixels interleave at random).
+		const int used = int(colsUsed);
+		for (int k = 0; k < used; k++)
+		{
+			outCell[n] = uint32_t(rowCell[k]);
+			outZ[n] = rowZ[k];
+			n += size_t(rowCell[k] >= 0);
 		}
 	}
+	out.commit(n);
+	const size_t binned = n - start;
 	return binned;
 }
 

@@ -29,9 +29,9 @@ void ElevationGrid::resize(const GridGeometry& g)
 	g.validate();
 	m_geom = g;
 	m_cells.assign(g.cellCount(), ElevationCell{});
-	m_frame.assign(g.cellCount(), ElevationCell{});
+	m_frame.assign(g.cellCount(), FrameCell{});
 	m_filterMean.assign(g.cellCount(), 0.f);
-	m_filterLimit.assign(g.cellCount(), 0.f);
+	m_filterLimit.assign(g.cellCount(), std::numeric_limits<float>::infinity());
 	m_touched.clear();
 	m_idwTouched.clear();
 	m_frameTouched.clear();
@@ -53,83 +53,98 @@ void ElevationGrid::recenter(double x_min, double y_min)
 	m_geom.y_min = y_min;
 }
 
+namespace
+{
+// Sums of a cell's samples relative to its first sample (`ref`). The 3-sigma
+// rule needs the std of each cell in one pass; the textbook E[z^2] - E[z]^2 of
+// plain float sums cancels catastrophically when |z| >> std (a floor at
+// z = 10 m with 3 mm noise got std ~0 and lost 15% of its samples), while the
+// deviations from a sample of the same cell are at most the cell's span.
+inline void accumulate(ElevationGrid::FrameCell& a, float z)
+{
+	if (!a.count) a.ref = z;
+	const float d = z - a.ref;
+	a.count++;
+	a.s1 += d;
+	a.s2 += d * d;
+	a.z_min = std::min(a.z_min, z);
+	a.z_max = std::max(a.z_max, z);
+}
+
+ElevationCell toCell(const ElevationGrid::FrameCell& a)
+{
+	ElevationCell c;
+	c.count = a.count;
+	c.z_min = a.z_min;
+	c.z_max = a.z_max;
+	const double n = a.count, ref = a.ref, s1 = a.s1, s2 = a.s2;
+	c.z_sum = float(n * ref + s1);
+	c.z_sq_sum = float(n * ref * ref + 2 * ref * s1 + s2);
+	return c;
+}
+}  // namespace
+
 size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams& filter)
 {
 	const size_t n = pts.size();
-	// Pass 1: per-cell statistics of this frame.
+	const uint32_t* cellOf = pts.cells().begin();
+	const float* zOf = pts.heights().begin();
+	// Pass 1: per-cell statistics of this frame. (Summing runs of equal cells
+	// in registers first was tried: slower, the run ends mispredict.)
 	for (size_t i = 0; i < n; i++)
 	{
-		const uint32_t c = pts.cell[i];
-		ElevationCell& fc = m_frame[c];
-		if (!fc.count) m_frameTouched.push_back(c);
-		fc.add(pts.z[i]);
+		FrameCell& a = m_frame[cellOf[i]];
+		if (!a.count) m_frameTouched.push_back(cellOf[i]);
+		accumulate(a, zOf[i]);
 	}
 
-	size_t kept = n;
-	if (filter.enabled)
+	// Per cell, the band mean +- k*std; cells whose samples all lie in it (or
+	// that are too small for the rule) are merged as they are; the others are
+	// flagged with their band and re-accumulated without their outliers.
+	size_t flagged = 0;
+	for (uint32_t c : m_frameTouched)
 	{
-		// Pass 2: per cell, the band mean +- k*std; cells whose samples all lie in
-		// it (or that are too small for the rule) are left untouched.
-		// The std comes from a second pass over the samples (sum of (z - mean)^2):
-		// the one-pass E[z^2] - E[z]^2 of the float sums cancels catastrophically
-		// when |z| >> std (a floor at z = 10 m with 3 mm noise got std ~0 and lost
-		// 15% of its samples, even with min_band).
-		for (uint32_t c : m_frameTouched)
-		{
-			m_filterMean[c] = m_frame[c].mean();
-			m_filterLimit[c] = 0.f;	 // sum of squared deviations, for now
-		}
+		FrameCell& a = m_frame[c];
+		if (!filter.enabled || a.count < filter.min_count) continue;
+		const float inv = 1.0f / float(a.count);
+		const float m1 = a.s1 * inv;
+		const float var = std::max(0.f, a.s2 * inv - m1 * m1);
+		const float lim = std::max(filter.min_band, filter.sigmas * std::sqrt(var));
+		const float mean = a.ref + m1;
+		if (mean - lim <= a.z_min && mean + lim >= a.z_max) continue;
+		m_filterMean[c] = mean;
+		m_filterLimit[c] = lim;	 // finite = flagged
+		a = FrameCell{};
+		flagged++;
+	}
+	size_t kept = n;
+	if (flagged)
+	{
+		// Pass 2, only if some cell had outliers: re-accumulate the flagged cells.
 		for (size_t i = 0; i < n; i++)
 		{
-			const uint32_t c = pts.cell[i];
-			const float d = pts.z[i] - m_filterMean[c];
-			m_filterLimit[c] += d * d;
-		}
-		bool anyFiltered = false;
-		for (uint32_t c : m_frameTouched)
-		{
-			ElevationCell& fc = m_frame[c];
-			const float ssd = m_filterLimit[c];
-			m_filterLimit[c] = std::numeric_limits<float>::infinity();
-			if (fc.count < filter.min_count) continue;
-			const float m = m_filterMean[c];
-			const float lim =
-				std::max(filter.min_band, filter.sigmas * std::sqrt(ssd / float(fc.count)));
-			if (m - lim <= fc.z_min && m + lim >= fc.z_max) continue;
-			anyFiltered = true;
-			m_filterLimit[c] = lim;
-			fc = ElevationCell{};
-		}
-		// Pass 3: re-accumulate the cells that had outliers, without them.
-		if (anyFiltered)
-		{
-			kept = 0;
-			for (size_t i = 0; i < n; i++)
-			{
-				const uint32_t c = pts.cell[i];
-				const float lim = m_filterLimit[c];
-				if (std::isinf(lim))
-					kept++;
-				else if (std::abs(pts.z[i] - m_filterMean[c]) <= lim)
-				{
-					m_frame[c].add(pts.z[i]);
-					kept++;
-				}
-			}
+			const uint32_t c = cellOf[i];
+			const float lim = m_filterLimit[c];
+			if (lim == std::numeric_limits<float>::infinity()) continue;
+			if (std::abs(zOf[i] - m_filterMean[c]) <= lim)
+				accumulate(m_frame[c], zOf[i]);
+			else
+				kept--;
 		}
 	}
 
 	// Merge into the grid and reset the scratch cells.
 	for (uint32_t c : m_frameTouched)
 	{
-		ElevationCell& fc = m_frame[c];
-		if (fc.count)
+		FrameCell& a = m_frame[c];
+		m_filterLimit[c] = std::numeric_limits<float>::infinity();
+		if (a.count)
 		{
 			ElevationCell& gc = m_cells[c];
 			if (!gc.count) m_touched.push_back(c);
-			gc.merge(fc);
+			gc.merge(toCell(a));
 		}
-		fc = ElevationCell{};
+		a = FrameCell{};
 	}
 	m_frameTouched.clear();
 	return kept;

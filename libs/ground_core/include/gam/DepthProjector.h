@@ -72,14 +72,33 @@ class DepthProjector
 		const RangeImageView& img, const PinholeIntrinsics& K, const RigidTransform& sensorToGrid,
 		const ProjectionFilter& f, const ElevationGrid& grid, BinnedPoints& out);
 
-	/** Per-pixel ray factors (x = 1; y, z) of the last intrinsics used. */
-	const std::vector<Eigen::Vector2f>& rayLut() const { return m_lut; }
+	/** Number of pixels in the ray table (that of the last intrinsics used). */
+	size_t rayTableSize() const { return m_rayY.size(); }
+	/** Ray factors (y/x, z/x) of pixel (row, col): the sensor-frame point of
+	 * depth D is (D, D*y/x, D*z/x). */
+	Eigen::Vector2f rayFactor(int row, int col) const
+	{
+		const size_t i = size_t(row) * size_t(m_lutK.width) + size_t(col);
+		return {m_rayY[i], m_rayZ[i]};
+	}
+
+	/** The per-frame constants of the pixel loop (cell units in x and y). */
+	struct RowParams
+	{
+		float rx[3], ry[3], rz[3], t[3];
+		float min_range, max_range, z_min, z_max, nx, ny, units;
+		int32_t nx_cells;
+	};
 
    private:
 	void updateLut(const PinholeIntrinsics& K);
 	PinholeIntrinsics m_lutK;
-	std::vector<Eigen::Vector2f> m_lut;	// (y/x, z/x) per pixel
-	std::vector<float> m_lutNorm;  // |(1, y/x, z/x)| per pixel, for range images
+	// Ray table, one entry per pixel, as separate arrays so the row loop vectorizes.
+	std::vector<float> m_rayY, m_rayZ;  // y/x and z/x
+	std::vector<float> m_rayInvNorm;	// 1 / |(1, y/x, z/x)|, for range images
+	// One row of results before compaction (cell or -1, z).
+	std::vector<int32_t> m_rowCell;
+	std::vector<float> m_rowZ;
 };
 
 }  // namespace gam

@@ -89,24 +89,55 @@ struct ElevationCell
 	}
 };
 
+/** A read-only view of `n` contiguous values (std::span is C++20). */
+template <class T>
+struct ConstSpan
+{
+	const T* first = nullptr;
+	size_t n = 0;
+	const T* begin() const { return first; }
+	const T* end() const { return first + n; }
+	size_t size() const { return n; }
+	const T& operator[](size_t i) const { return first[i]; }
+};
+
 /** Height samples of one frame, already binned: the cell index and the z of each
  * point. Filled by the projectors (DepthProjector, or any point source), then
- * merged into an ElevationGrid. Reused between frames to avoid allocations. */
-struct BinnedPoints
+ * merged into an ElevationGrid. Reused between frames: the buffers only grow,
+ * so a steady stream of frames allocates nothing. */
+class BinnedPoints
 {
-	std::vector<uint32_t> cell;
-	std::vector<float> z;
-	void clear()
-	{
-		cell.clear();
-		z.clear();
-	}
-	size_t size() const { return cell.size(); }
+   public:
+	void clear() { m_size = 0; }
+	size_t size() const { return m_size; }
+	bool empty() const { return m_size == 0; }
+	ConstSpan<uint32_t> cells() const { return {m_cell.data(), m_size}; }
+	ConstSpan<float> heights() const { return {m_z.data(), m_size}; }
 	void push(uint32_t c, float zz)
 	{
-		cell.push_back(c);
-		z.push_back(zz);
+		if (m_size == m_cell.size()) grow(m_size + 1);
+		m_cell[m_size] = c;
+		m_z[m_size] = zz;
+		m_size++;
 	}
+	/** For bulk writers: room for `extra` more samples at cellBuffer()[size()...]
+	 * and zBuffer()[size()...]; then commit() the new size. */
+	void prepare(size_t extra) { grow(m_size + extra); }
+	uint32_t* cellBuffer() { return m_cell.data(); }
+	float* zBuffer() { return m_z.data(); }
+	void commit(size_t newSize) { m_size = std::min(newSize, m_cell.size()); }
+
+   private:
+	void grow(size_t need)
+	{
+		if (need <= m_cell.size()) return;
+		const size_t n = std::max<size_t>({need, 2 * m_cell.size(), 1024});
+		m_cell.resize(n);
+		m_z.resize(n);
+	}
+	std::vector<uint32_t> m_cell;
+	std::vector<float> m_z;
+	size_t m_size = 0;
 };
 
 /** Per-cell outlier removal (paper §IV.A: the 3-sigma rule). */
@@ -188,13 +219,22 @@ class ElevationGrid
 		return c.count ? c.mean() : c.z_idw;
 	}
 
+	/** One frame's samples of a cell, relative to its first sample (see insert()). */
+	struct FrameCell
+	{
+		float ref = 0, s1 = 0, s2 = 0;
+		float z_min = std::numeric_limits<float>::infinity();
+		float z_max = -std::numeric_limits<float>::infinity();
+		uint32_t count = 0;
+	};
+
    private:
 	GridGeometry m_geom;
 	std::vector<ElevationCell> m_cells;
 	std::vector<uint32_t> m_touched;  // cells with count > 0
 	std::vector<uint32_t> m_idwTouched;	 // cells holding an IDW value
 	// Frame scratch (kept to avoid per-frame allocations):
-	std::vector<ElevationCell> m_frame;
+	std::vector<FrameCell> m_frame;
 	std::vector<uint32_t> m_frameTouched;
 	std::vector<float> m_filterMean, m_filterLimit;
 	std::vector<float> m_idwWeights;
