@@ -89,14 +89,23 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 	const size_t n = pts.size();
 	const uint32_t* cellOf = pts.cells().begin();
 	const float* zOf = pts.heights().begin();
-	// Pass 1: per-cell statistics of this frame. (Summing runs of equal cells
-	// in registers first was tried: slower, the run ends mispredict.)
-	for (size_t i = 0; i < n; i++)
-	{
+	// Pass 1: per-cell statistics of this frame. Neighbouring samples mostly
+	// share a cell, and each update then waits for the previous one's store:
+	// walking the two halves of the frame in lockstep interleaves two such
+	// chains (different cells, far apart in the image). Summing runs of equal
+	// cells in registers instead was tried: slower, the run ends mispredict.
+	auto add = [&](size_t i) {
 		FrameCell& a = m_frame[cellOf[i]];
 		if (!a.count) m_frameTouched.push_back(cellOf[i]);
 		accumulate(a, zOf[i]);
+	};
+	const size_t half = n / 2;
+	for (size_t i = 0; i < half; i++)
+	{
+		add(i);
+		add(half + i);
 	}
+	if (n % 2) add(n - 1);
 
 	// Per cell, the band mean +- k*std; cells whose samples all lie in it (or
 	// that are too small for the rule) are merged as they are; the others are
