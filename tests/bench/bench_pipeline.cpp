@@ -1,12 +1,13 @@
 // Per-stage and whole-pipeline timings of the ground-aware grid, and the two
 // comparison maps on the same frames, with Google Benchmark (Release build).
 //
-//   gam-bench [--frames=N] FILE.rawlog [FILE.rawlog ...] [benchmark flags]
+//   gam-bench [--frames=N] [--full-octomap=M] FILE.rawlog [FILE.rawlog ...] [benchmark flags]
 //
 // Each rawlog's 3D frames (up to N, default 20) are loaded once; every case
 // cycles through them. After the cases, a summary prints median and p95 ms
 // per frame of the whole pipeline and of height_band / octomap on the same
-// frames, and the ratios.
+// frames, and the ratios; then the ground-aware grid's stages (median / p95);
+// with --full-octomap=M, also the octomap fed every pixel (first M frames).
 #include <benchmark/benchmark.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
@@ -22,6 +23,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -213,13 +215,16 @@ void BM_WholeMap(benchmark::State& st, const Dataset* d)
 
 // --- the summary: same frames, each map, median / p95 -----------------------
 template <class MAP>
-std::vector<double> timesOf(const Dataset& d, int rounds)
+std::vector<double> timesOf(
+	const Dataset& d, int rounds, size_t maxFrames = 0, const std::function<void(MAP&)>& setup = {})
 {
 	MAP grid;
+	if (setup) setup(grid);
 	std::vector<double> ms;
 	for (int r = 0; r < rounds; r++)
-		for (const Frame& f : d.frames)
+		for (size_t i = 0; i < d.frames.size() && (!maxFrames || i < maxFrames); i++)
 		{
+			const Frame& f = d.frames[i];
 			const auto t0 = std::chrono::steady_clock::now();
 			grid.insertObservation(*f.depth, f.pose);
 			ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
@@ -228,20 +233,48 @@ std::vector<double> timesOf(const Dataset& d, int rounds)
 }
 double quantile(std::vector<double> v, double q)
 {
+	if (v.empty()) return 0;
 	std::sort(v.begin(), v.end());
 	return v[std::min(v.size() - 1, size_t(q * double(v.size())))];
+}
+
+// The ground-aware grid's own per-stage timings (lastFrame()), frame by frame.
+struct StageTimes
+{
+	std::vector<double> projection, outliers, ground, ism, update, total;
+};
+StageTimes stageTimesOf(const Dataset& d, int rounds)
+{
+	CGroundAwareOccupancyGrid grid;
+	StageTimes st;
+	for (int r = 0; r < rounds; r++)
+		for (const Frame& f : d.frames)
+		{
+			grid.insertObservation(*f.depth, f.pose);
+			const auto& l = grid.lastFrame();
+			st.projection.push_back(l.ms_projection);
+			st.outliers.push_back(l.ms_outliers);
+			st.ground.push_back(l.ms_ground);
+			st.ism.push_back(l.ms_ism);
+			st.update.push_back(l.ms_update);
+			st.total.push_back(l.ms_total);
+		}
+	return st;
 }
 }  // namespace
 
 int main(int argc, char** argv)
 {
 	size_t maxFrames = 20;
+	int fullOctomapFrames = 0;
 	std::vector<std::string> files;
 	std::vector<char*> bargs{argv[0]};
 	for (int i = 1; i < argc; i++)
 	{
 		if (std::strncmp(argv[i], "--frames=", 9) == 0)
 			maxFrames = size_t(std::max(1, std::atoi(argv[i] + 9)));
+		else if (std::strncmp(argv[i], "--full-octomap=", 15) == 0)
+			fullOctomapFrames = std::max(0, std::atoi(argv[i] + 15));
 		else if (std::strncmp(argv[i], "--", 2) == 0)
 			bargs.push_back(argv[i]);
 		else
@@ -249,7 +282,7 @@ int main(int argc, char** argv)
 	}
 	if (files.empty())
 	{
-		std::cerr << "usage: gam-bench [--frames=N] FILE.rawlog [...] [benchmark flags]\n";
+		std::cerr << "usage: gam-bench [--frames=N] [--full-octomap=M] FILE.rawlog [...] [benchmark flags]\n";
 		return 2;
 	}
 	try
@@ -288,6 +321,36 @@ int main(int argc, char** argv)
 		std::printf("| %s | %zu | %zux%zu | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.1fx | %.1fx |\n", d.name.c_str(),
 					d.frames.size(), size_t(d.frames[0].depth->rangeImage.cols()), size_t(d.frames[0].depth->rangeImage.rows()),
 					mga, quantile(ga, 0.95), mhb, quantile(hb, 0.95), mom, quantile(om, 0.95), mhb / mga, mom / mga);
+	}
+
+	std::printf("\nground_aware per stage (the map's own timers), median / p95 ms:\n\n| data | 2.5D projection | 3-sigma filter + IDW | RRT-GPD | ISM | grid update | whole frame |\n|---|---|---|---|---|---|---|\n");
+	for (const Dataset& d : g_data)
+	{
+		const StageTimes t = stageTimesOf(d, std::max(1, int(40 / d.frames.size())));
+		auto mp = [](const std::vector<double>& v) {
+			char b[64];
+			std::snprintf(b, sizeof b, "%.3f / %.3f", quantile(v, 0.5), quantile(v, 0.95));
+			return std::string(b);
+		};
+		std::printf("| %s | %s | %s | %s | %s | %s | %s |\n", d.name.c_str(), mp(t.projection).c_str(),
+					mp(t.outliers).c_str(), mp(t.ground).c_str(), mp(t.ism).c_str(), mp(t.update).c_str(),
+					mp(t.total).c_str());
+	}
+
+	if (fullOctomapFrames > 0)
+	{
+		// The run's octomap inserts every 4th pixel of every 4th row (decimation 4,
+		// ground-aware-mapper.ini): 1/16 of what the ground-aware grid reads. This
+		// times it on every pixel too, the same input as the ground-aware grid.
+		std::printf("\noctomap on every pixel (decimation 1), first %d frames:\n\n| data | octomap (every pixel) median / p95 ms | ground_aware median ms | ratio |\n|---|---|---|---|\n", fullOctomapFrames);
+		for (const Dataset& d : g_data)
+		{
+			const auto om = timesOf<COctoMapGrid2D>(
+				d, 1, size_t(fullOctomapFrames), [](COctoMapGrid2D& m) { m.octoOptions.decimation = 1; });
+			const auto ga = timesOf<CGroundAwareOccupancyGrid>(d, std::max(1, int(40 / d.frames.size())));
+			std::printf("| %s | %.1f / %.1f | %.2f | %.0fx |\n", d.name.c_str(), quantile(om, 0.5), quantile(om, 0.95),
+						quantile(ga, 0.5), quantile(om, 0.5) / quantile(ga, 0.5));
+		}
 	}
 	return 0;
 }
