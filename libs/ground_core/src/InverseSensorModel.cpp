@@ -85,8 +85,8 @@ void InverseSensorModel::measureFloorNoise(
 	const size_t nb = size_t(std::ceil((m_params.max_range + 1.0) / kNoiseBin));
 	m_floorNoise.assign(nb, -1.f);
 	if (!m_params.measure_floor_noise || m_params.noise_sigmas <= 0) return;
-	m_noiseSamples.resize(nb);
-	for (auto& v : m_noiseSamples) v.clear();
+	m_noiseBin.clear();
+	m_noiseValue.clear();
 	for (uint32_t idx : frame.observedCells())
 	{
 		const ElevationCell& c = frame.cell(idx);
@@ -98,14 +98,27 @@ void InverseSensorModel::measureFloorNoise(
 		if (std::abs(pl.signedDistance(x, y, c.mean())) > m_params.d_pth) continue;
 		const Eigen::Vector3d d(x - sensor.x(), y - sensor.y(), c.mean() - sensor.z());
 		const size_t bin = size_t(d.norm() / kNoiseBin);
-		if (bin < nb) m_noiseSamples[bin].push_back(std::sqrt(c.variance()));
+		if (bin < nb)
+		{
+			m_noiseBin.push_back(uint32_t(bin));
+			m_noiseValue.push_back(std::sqrt(c.variance()));
+		}
 	}
+	// Group the samples by bin (stable counting sort), then the median of each.
+	m_noiseBinStart.assign(nb + 1, 0);
+	for (uint32_t b : m_noiseBin) m_noiseBinStart[b + 1]++;
+	for (size_t b = 0; b < nb; b++) m_noiseBinStart[b + 1] += m_noiseBinStart[b];
+	m_noiseSorted.resize(m_noiseValue.size());
+	for (size_t i = 0; i < m_noiseBin.size(); i++) m_noiseSorted[m_noiseBinStart[m_noiseBin[i]]++] = m_noiseValue[i];
+	// m_noiseBinStart[b] is now the end of bin b (= the start of bin b + 1).
 	for (size_t b = 0; b < nb; b++)
 	{
-		auto& v = m_noiseSamples[b];
-		if (v.size() < size_t(std::max(1, m_params.floor_noise_min_cells))) continue;
-		std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-		m_floorNoise[b] = v[v.size() / 2];
+		const uint32_t begin = b == 0 ? 0 : m_noiseBinStart[b - 1], end = m_noiseBinStart[b];
+		const size_t n = end - begin;
+		if (n < size_t(std::max(1, m_params.floor_noise_min_cells))) continue;
+		float* v = m_noiseSorted.data() + begin;
+		std::nth_element(v, v + long(n / 2), v + n);
+		m_floorNoise[b] = v[n / 2];
 	}
 }
 
@@ -193,6 +206,14 @@ void InverseSensorModel::compute(
 		m_class.assign(g.cellCount(), VoxelClass::None);
 		m_evidenceCells.clear();
 		m_classCells.clear();
+		// Each list holds a cell at most once: with the capacity of the whole
+		// grid, no frame ever needs to grow them (no per-frame allocation).
+		m_evidenceCells.reserve(g.cellCount());
+		m_classCells.reserve(g.cellCount());
+		m_dropVoxels.reserve(g.cellCount());
+		m_noiseBin.reserve(g.cellCount());
+		m_noiseValue.reserve(g.cellCount());
+		m_noiseSorted.reserve(g.cellCount());
 	}
 	for (uint32_t c : m_evidenceCells) m_evidence[c] = 0.5f;
 	m_evidenceCells.clear();

@@ -78,8 +78,18 @@ std::optional<Plane> fitPlaneTotalLeastSquares(const std::vector<Eigen::Vector3d
 std::optional<RansacResult> fitPlaneRansac(
 	const std::vector<Eigen::Vector3d>& pts, const RansacParams& p, std::mt19937& rng)
 {
+	RansacResult res;
+	std::vector<Eigen::Vector3d> inl;
+	if (!fitPlaneRansac(pts, p, rng, res, inl)) return std::nullopt;
+	return res;
+}
+
+bool fitPlaneRansac(
+	const std::vector<Eigen::Vector3d>& pts, const RansacParams& p, std::mt19937& rng,
+	RansacResult& res, std::vector<Eigen::Vector3d>& inl)
+{
 	const size_t n = pts.size();
-	if (n < 3 || n < p.min_inliers) return std::nullopt;
+	if (n < 3 || n < p.min_inliers) return false;
 	std::uniform_int_distribution<size_t> pick(0, n - 1);
 	size_t bestCount = 0;
 	Plane best;
@@ -101,10 +111,10 @@ std::optional<RansacResult> fitPlaneRansac(
 			if (cnt == n) break;
 		}
 	}
-	if (bestCount < std::max<size_t>(3, p.min_inliers)) return std::nullopt;
+	if (bestCount < std::max<size_t>(3, p.min_inliers)) return false;
 
-	RansacResult res;
-	std::vector<Eigen::Vector3d> inl;
+	res.inliers.clear();
+	inl.clear();
 	for (size_t i = 0; i < n; i++)
 		if (std::abs(best.signedDistance(pts[i].x(), pts[i].y(), pts[i].z())) <= p.inlier_distance)
 		{
@@ -113,7 +123,7 @@ std::optional<RansacResult> fitPlaneRansac(
 		}
 	const auto refined = fitPlaneTotalLeastSquares(inl);
 	res.plane = (refined && refined->horizontalNormal() <= p.max_horizontal_normal) ? *refined : best;
-	return res;
+	return true;
 }
 
 }  // namespace gam

@@ -3,7 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <nanoflann.hpp>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -11,24 +11,6 @@ namespace gam
 {
 namespace
 {
-// nanoflann adaptor: the (x, y) of the tree nodes.
-struct NodeCloud
-{
-	const std::vector<GroundNode>* nodes = nullptr;
-	size_t kdtree_get_point_count() const { return nodes->size(); }
-	float kdtree_get_pt(size_t i, size_t dim) const
-	{
-		return dim == 0 ? (*nodes)[i].x : (*nodes)[i].y;
-	}
-	template <class BBOX>
-	bool kdtree_get_bbox(BBOX&) const
-	{
-		return false;
-	}
-};
-using NodeIndex = nanoflann::KDTreeSingleIndexDynamicAdaptor<
-	nanoflann::L2_Simple_Adaptor<float, NodeCloud>, NodeCloud, 2, uint32_t>;
-
 void require(bool ok, const char* name, const std::string& range, double v)
 {
 	if (!ok)
@@ -186,6 +168,7 @@ void RrtGroundDetector::detect(
 	}
 	const GridGeometry& g = grid.geometry();
 	m_rng.seed(m_params.random_seed);
+	reserveScratch(g);
 
 	m_seedExcluded.clear();
 	for (int attempt = 0; attempt < m_params.seed_attempts; attempt++)
@@ -225,25 +208,147 @@ void RrtGroundDetector::detect(
 									: GroundDetection::Status::Ok;
 }
 
+size_t RrtGroundDetector::maxTreeNodes(const GridGeometry& g) const
+{
+	return std::min(size_t(m_params.iterations) + 1, g.cellCount());
+}
+
+void RrtGroundDetector::reserveScratch(const GridGeometry& g)
+{
+	// Everything detect() fills is bounded by the most nodes a tree can have
+	// (K + 1, and one per cell), s_x * s_y fit cells and max_planes: reserving
+	// that once keeps every later frame (with the same grid and parameters)
+	// free of heap allocations. No-ops when the capacity is already there.
+	const size_t maxNodes = maxTreeNodes(g);
+	m_nodeCells.reserve(maxNodes);
+	m_bucketNext.reserve(maxNodes);
+	m_bucketsUsed.reserve(maxNodes);
+	m_remaining.reserve(maxNodes);
+	m_rest.reserve(maxNodes);
+	m_flag.reserve(maxNodes);
+	m_ransacPts.reserve(maxNodes);
+	m_ransacInliers.reserve(maxNodes);
+	m_ransac.inliers.reserve(maxNodes);
+	m_fitPts.reserve(size_t(m_params.neighbourhood_x) * size_t(m_params.neighbourhood_y));
+	if (m_hasNode.size() != g.cellCount())
+	{
+		m_hasNode.assign(g.cellCount(), 0);
+		m_nodeCells.clear();  // indices into the old grid (it may have been larger)
+	}
+	// Buckets of about d_n: a node's nearest neighbour is usually within one
+	// or two rings of buckets.
+	const int B = std::clamp(int(std::ceil(m_params.expansion_distance / g.resolution)), 1, 64);
+	const int bnx = (g.nx + B - 1) / B, bny = (g.ny + B - 1) / B;
+	if (B != m_bucketCells || bnx != m_bnx || bny != m_bny)
+	{
+		m_bucketCells = B;
+		m_bnx = bnx;
+		m_bny = bny;
+		m_bucketHead.assign(size_t(bnx) * size_t(bny), -1);
+		m_bucketsUsed.clear();
+	}
+}
+
+void RrtGroundDetector::nodeIndexReset(const GridGeometry& g)
+{
+	for (uint32_t b : m_bucketsUsed) m_bucketHead[b] = -1;
+	m_bucketsUsed.clear();
+	m_bucketNext.clear();
+	m_bucketSize = m_bucketCells * g.resolution;
+	m_bucketX0 = g.x_min;
+	m_bucketY0 = g.y_min;
+}
+
+void RrtGroundDetector::nodeIndexAdd(uint32_t node, int cx, int cy)
+{
+	const uint32_t b = uint32_t(cy / m_bucketCells) * uint32_t(m_bnx) + uint32_t(cx / m_bucketCells);
+	if (m_bucketHead[b] < 0) m_bucketsUsed.push_back(b);
+	// Nodes are added in index order: m_bucketNext[node] is its own slot.
+	m_bucketNext.push_back(m_bucketHead[b]);
+	m_bucketHead[b] = int32_t(node);
+}
+
+uint32_t RrtGroundDetector::nodeIndexNearest(
+	const std::vector<GroundNode>& nodes, float qx, float qy, float& bestD2) const
+{
+	// Exact nearest node, visiting rings of buckets around the query's bucket
+	// (clamped to the grid: the query lies in it) until no unvisited bucket
+	// can hold anything closer. The distance is computed exactly as nanoflann's
+	// L2_Simple_Adaptor<float> did (same float operations), so the nearest
+	// node is the same; on an exact tie the lowest index wins.
+	const int qbx = std::clamp(int(std::floor((double(qx) - m_bucketX0) / m_bucketSize)), 0, m_bnx - 1);
+	const int qby = std::clamp(int(std::floor((double(qy) - m_bucketY0) / m_bucketSize)), 0, m_bny - 1);
+	const int maxRing = std::max(std::max(qbx, m_bnx - 1 - qbx), std::max(qby, m_bny - 1 - qby));
+	bestD2 = std::numeric_limits<float>::max();
+	int32_t best = -1;
+	auto scan = [&](int bx, int by) {
+		for (int32_t i = m_bucketHead[size_t(by) * size_t(m_bnx) + size_t(bx)]; i >= 0; i = m_bucketNext[size_t(i)])
+		{
+			const GroundNode& n = nodes[size_t(i)];
+			float d2 = 0;
+			const float dx = qx - n.x;
+			d2 += dx * dx;
+			const float dy = qy - n.y;
+			d2 += dy * dy;
+			if (d2 < bestD2 || (d2 == bestD2 && i < best))
+			{
+				bestD2 = d2;
+				best = i;
+			}
+		}
+	};
+	for (int r = 0; r <= maxRing; r++)
+	{
+		const int x0 = qbx - r, x1 = qbx + r, y0 = qby - r, y1 = qby + r;
+		for (int by = std::max(0, y0); by <= std::min(m_bny - 1, y1); by++)
+		{
+			if (by == y0 || by == y1)
+			{
+				for (int bx = std::max(0, x0); bx <= std::min(m_bnx - 1, x1); bx++) scan(bx, by);
+			}
+			else
+			{
+				if (x0 >= 0) scan(x0, by);
+				if (x1 < m_bnx) scan(x1, by);
+			}
+		}
+		// A node in ring r+1 or beyond is at least r bucket sides away along
+		// x or y (nodes sit on cell centres, half a cell inside their bucket,
+		// which covers float round-off). Strictly closer: ties are resolved.
+		if (best >= 0)
+		{
+			const double reach = r * m_bucketSize;
+			if (double(bestD2) < reach * reach) break;
+		}
+	}
+	return uint32_t(best);
+}
+
 void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out)
 {
 	const GridGeometry& g = grid.geometry();
 	out.nodes.clear();
 	out.iterations = 0;
-	if (m_hasNode.size() != g.cellCount()) m_hasNode.assign(g.cellCount(), 0);
 	for (uint32_t c : m_nodeCells) m_hasNode[c] = 0;
 	m_nodeCells.clear();
 
-	out.nodes.reserve(size_t(m_params.iterations) + 1);
+	// The paper keeps the nodes in a k-d tree for the nearest-node queries.
+	// nanoflann's dynamic k-d tree did that, but it rebuilds sub-trees as nodes
+	// are added and its PooledAllocator mallocs and frees their memory on every
+	// rebuild (hundreds of allocations per frame), which a real-time frame loop
+	// must not do. Nodes lie one per grid cell inside a bounded grid, so a
+	// uniform bucket grid gives the same exact nearest neighbour with storage
+	// reused between frames (see nodeIndexNearest).
+	nodeIndexReset(g);
+	out.nodes.reserve(maxTreeNodes(g));
 	out.nodes.push_back(seed);
 	{
-		const uint32_t c = uint32_t(g.index(g.ix(seed.x), g.iy(seed.y)));
+		const int sx = g.ix(seed.x), sy = g.iy(seed.y);
+		const uint32_t c = uint32_t(g.index(sx, sy));
 		m_hasNode[c] = 1;
 		m_nodeCells.push_back(c);
+		nodeIndexAdd(0, sx, sy);
 	}
-	NodeCloud cloud{&out.nodes};
-	NodeIndex index(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10), size_t(m_params.iterations) + 2);
-	index.addPoints(0, 0);
 
 	// Sampling window: the nodes' bounding box grown by window_margin, clamped
 	// to the grid. It grows and drifts as the tree explores.
@@ -259,12 +364,8 @@ void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& se
 		const double wy0 = std::max(g.y_min, by0 - margin), wy1 = std::min(g.y_max(), by1 + margin);
 		const double qx = wx0 + U(m_rng) * (wx1 - wx0), qy = wy0 + U(m_rng) * (wy1 - wy0);
 
-		uint32_t nearIdx = 0;
 		float nearD2 = 0;
-		const float q[2] = {float(qx), float(qy)};
-		nanoflann::KNNResultSet<float, uint32_t> rs(1);
-		rs.init(&nearIdx, &nearD2);
-		index.findNeighbors(rs, q, nanoflann::SearchParams());
+		const uint32_t nearIdx = nodeIndexNearest(out.nodes, float(qx), float(qy), nearD2);
 		const GroundNode near = out.nodes[nearIdx];	 // copy: push_back may reallocate
 
 		const double dist = std::sqrt(double(nearD2));
@@ -297,13 +398,12 @@ void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& se
 		out.nodes.push_back(node);
 		m_hasNode[cidx] = 1;
 		m_nodeCells.push_back(cidx);
-		index.addPoints(out.nodes.size() - 1, out.nodes.size() - 1);
+		nodeIndexAdd(uint32_t(out.nodes.size() - 1), cx, cy);
 		bx0 = std::min(bx0, px);
 		bx1 = std::max(bx1, px);
 		by0 = std::min(by0, py);
 		by1 = std::max(by1, py);
 	}
-
 }
 
 void RrtGroundDetector::fitPlanes(GroundDetection& out)
@@ -311,13 +411,25 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 	// RANSAC over the node centres gives the ground plane; further RANSAC rounds
 	// over the remaining nodes give ramps and other ground patches that the tree
 	// reached through small elevation changes.
-	std::vector<size_t> remaining(out.nodes.size());
+	// (All vectors are members: see reserveScratch.)
+	std::vector<size_t>& remaining = m_remaining;
+	remaining.resize(out.nodes.size());
 	for (size_t i = 0; i < remaining.size(); i++) remaining[i] = i;
-	std::vector<Eigen::Vector3d> pts;
+	std::vector<Eigen::Vector3d>& pts = m_ransacPts;
 	RansacParams rp;
 	rp.iterations = m_params.ransac_iterations;
 	rp.inlier_distance = m_params.ransac_inlier_distance;
 	rp.max_horizontal_normal = m_params.normal_threshold;
+	out.planes.reserve(size_t(m_params.max_planes));
+	out.plane_support.reserve(size_t(m_params.max_planes));
+
+	// Keeps the remaining nodes whose m_flag is 0, in order.
+	auto keepUnflagged = [this]() {
+		m_rest.clear();
+		for (size_t i = 0; i < m_remaining.size(); i++)
+			if (!m_flag[i]) m_rest.push_back(m_remaining[i]);
+		m_remaining.swap(m_rest);
+	};
 
 	for (int k = 0; k < m_params.max_planes && remaining.size() >= 3; k++)
 	{
@@ -326,8 +438,8 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		if (k > 0 && m_params.min_nodes_per_extra_plane == 0) break;
 		pts.clear();
 		for (size_t i : remaining) pts.emplace_back(out.nodes[i].x, out.nodes[i].y, out.nodes[i].z);
-		const auto r = fitPlaneRansac(pts, rp, m_rng);
-		if (!r) break;
+		if (!fitPlaneRansac(pts, rp, m_rng, m_ransac, m_ransacInliers)) break;
+		const RansacResult* r = &m_ransac;
 
 		Plane plane = r->plane;
 		// Nearly collinear node sets (a corridor crossed by one line of nodes)
@@ -349,12 +461,9 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		const bool lineLike = minorStd < 0.25 * m_params.expansion_distance;
 		if (k > 0 && lineLike)
 		{
-			std::vector<uint8_t> drop(remaining.size(), 0);
-			for (size_t i : r->inliers) drop[i] = 1;
-			std::vector<size_t> rest;
-			for (size_t i = 0; i < remaining.size(); i++)
-				if (!drop[i]) rest.push_back(remaining[i]);
-			remaining.swap(rest);
+			m_flag.assign(remaining.size(), 0);
+			for (size_t i : r->inliers) m_flag[i] = 1;
+			keepUnflagged();
 			continue;
 		}
 		if (minorStd < 0.5 * m_params.expansion_distance)
@@ -371,16 +480,13 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		const int id = int(out.planes.size());
 		out.planes.push_back(plane);
 		out.plane_support.push_back(r->inliers.size());
-		std::vector<uint8_t> isInlier(remaining.size(), 0);
+		m_flag.assign(remaining.size(), 0);
 		for (size_t i : r->inliers)
 		{
-			isInlier[i] = 1;
+			m_flag[i] = 1;
 			out.nodes[remaining[i]].plane_id = id;
 		}
-		std::vector<size_t> rest;
-		for (size_t i = 0; i < remaining.size(); i++)
-			if (!isInlier[i]) rest.push_back(remaining[i]);
-		remaining.swap(rest);
+		keepUnflagged();
 	}
 }
 

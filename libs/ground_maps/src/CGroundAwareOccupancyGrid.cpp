@@ -317,8 +317,7 @@ bool CGroundAwareOccupancyGrid::insert3D(
 	const auto& o = groundOptions;
 	if (!std::isfinite(robotPose.x()) || !std::isfinite(robotPose.y()) || !std::isfinite(robotPose.z()))
 		throw std::invalid_argument("robot pose is not finite");
-	m_last = TFrameDiagnostics{};
-	m_last.detection.nodes.clear();
+	resetLastFrame();
 
 	// 1. The robot-centred 2.5D map, aligned with this grid's cells.
 	const double res = getResolution();
@@ -381,6 +380,26 @@ bool CGroundAwareOccupancyGrid::insert3D(
 	// A frame is "inserted" even if it found no ground: it was processed, and
 	// lastFrame() says why nothing changed.
 	return true;
+}
+
+void CGroundAwareOccupancyGrid::resetLastFrame()
+{
+	// As m_last = TFrameDiagnostics{}, but the detection's vectors keep their
+	// capacity: no heap allocation per frame once they have grown (issue #6).
+	gam::GroundDetection& d = m_last.detection;
+	std::vector<gam::GroundNode> nodes;
+	std::vector<gam::Plane> planes;
+	std::vector<size_t> support;
+	nodes.swap(d.nodes);
+	planes.swap(d.planes);
+	support.swap(d.plane_support);
+	m_last = TFrameDiagnostics{};
+	nodes.clear();
+	planes.clear();
+	support.clear();
+	m_last.detection.nodes.swap(nodes);
+	m_last.detection.planes.swap(planes);
+	m_last.detection.plane_support.swap(support);
 }
 
 void CGroundAwareOccupancyGrid::applyEvidence()

@@ -139,7 +139,11 @@ class InverseSensorModel
 
 	static constexpr double kNoiseBin = 0.5;  ///< range bin of the floor noise [m]
 	std::vector<float> m_floorNoise;  ///< per bin: measured std [m], < 0 = not measured
-	std::vector<std::vector<float>> m_noiseSamples;
+	// Floor samples of all bins in one buffer (bounded by the cell count, so
+	// never reallocated per frame): (bin, std) pairs, then grouped by bin.
+	std::vector<uint32_t> m_noiseBin;
+	std::vector<float> m_noiseValue, m_noiseSorted;
+	std::vector<uint32_t> m_noiseBinStart;
 
 	IsmParams m_params;
 	std::vector<float> m_evidence;

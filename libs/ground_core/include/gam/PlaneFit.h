@@ -61,4 +61,12 @@ struct RansacResult
 std::optional<RansacResult> fitPlaneRansac(
 	const std::vector<Eigen::Vector3d>& pts, const RansacParams& p, std::mt19937& rng);
 
+/** The same fit into caller-owned storage: `out.inliers` and `inlierScratch`
+ * keep their capacity, so repeated calls need no heap allocation. Returns
+ * false where the other overload returns std::nullopt (`out` is then
+ * unspecified). Same result and same use of `rng` as the other overload. */
+bool fitPlaneRansac(
+	const std::vector<Eigen::Vector3d>& pts, const RansacParams& p, std::mt19937& rng,
+	RansacResult& out, std::vector<Eigen::Vector3d>& inlierScratch);
+
 }  // namespace gam

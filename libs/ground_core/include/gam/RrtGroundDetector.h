@@ -104,7 +104,9 @@ class RrtGroundDetector
 	void setParams(const RrtGpdParams& p) { m_params = p; }
 	const RrtGpdParams& params() const { return m_params; }
 
-	/** Runs Algorithm 1 on `grid`. Deterministic for equal inputs and seed. */
+	/** Runs Algorithm 1 on `grid`. Deterministic for equal inputs and seed.
+	 * Reuses its buffers and `out`'s vectors: after the first call with a given
+	 * grid size and parameters it makes no heap allocation. */
 	void detect(const ElevationGrid& grid, const GroundSeedHint& hint, GroundDetection& out);
 
 	/** Local least-squares plane of the s_x * s_y cells around (cx, cy), using
@@ -116,16 +118,36 @@ class RrtGroundDetector
 	bool findSeed(const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed);
 	void growTree(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
 	void fitPlanes(GroundDetection& out);
+	void reserveScratch(const GridGeometry& g);
+	size_t maxTreeNodes(const GridGeometry& g) const;
+
+	// Nearest tree node to a query point (the "nodes in a k-d tree" of the
+	// paper), as a uniform bucket grid over the frame grid: see growTree().
+	void nodeIndexReset(const GridGeometry& g);
+	void nodeIndexAdd(uint32_t node, int cx, int cy);
+	uint32_t nodeIndexNearest(const std::vector<GroundNode>& nodes, float qx, float qy, float& d2) const;
 
 	RrtGpdParams m_params;
 	std::mt19937 m_rng;
-	// Scratch, reused between frames:
+	// Scratch, reused between frames (cleared, never shrunk): after the first
+	// frame of a given grid size and parameters, detect() allocates nothing.
 	std::vector<uint8_t> m_hasNode;
 	std::vector<uint32_t> m_nodeCells;
 	mutable std::vector<Eigen::Vector3d> m_fitPts;
 	std::vector<std::pair<int, int>> m_ringOffsets;
 	std::vector<uint8_t> m_seedExcluded;
 	int m_ringRadius = -1;
+	// Node index: per bucket the first node (-1 = empty), per node the next one.
+	std::vector<int32_t> m_bucketHead;
+	std::vector<int32_t> m_bucketNext;
+	std::vector<uint32_t> m_bucketsUsed;
+	int m_bucketCells = 1, m_bnx = 0, m_bny = 0;
+	double m_bucketSize = 0, m_bucketX0 = 0, m_bucketY0 = 0;
+	// fitPlanes():
+	std::vector<size_t> m_remaining, m_rest;
+	std::vector<uint8_t> m_flag;
+	std::vector<Eigen::Vector3d> m_ransacPts, m_ransacInliers;
+	RansacResult m_ransac;
 };
 
 }  // namespace gam

@@ -151,6 +151,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		const mrpt::obs::CObservation2DRangeScan& scan,
 		const std::optional<const mrpt::poses::CPose3D>& robotPose);
 	void applyEvidence();
+	void resetLastFrame();
 
 	// Per-frame workspace (not serialized).
 	gam::ElevationGrid m_frame;
