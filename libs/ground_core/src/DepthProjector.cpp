@@ -1,5 +1,7 @@
 #include "gam/DepthProjector.h"
 
+#include "ProjectRow.h"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -68,38 +70,6 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 
 namespace
 {
-// One pixel: its grid cell (-1 if it is dropped) and its height.
-template <bool kDepth>
-inline void projectPixel(
-	const DepthProjector::RowParams& p, uint16_t raw, float ky, float kz, float invNorm, int32_t& cell, float& z)
-{
-	const float v = float(raw) * p.units;  // 0 = no return: fails v > 0 below
-	const float D = kDepth ? v : v * invNorm;
-	// Sensor-frame point (D, D*ky, D*kz) mapped to the grid frame.
-	const float sy = D * ky, sz = D * kz;
-	const float fx = p.rx[0] * D + p.rx[1] * sy + p.rx[2] * sz + p.t[0];	// cells
-	const float fy = p.ry[0] * D + p.ry[1] * sy + p.ry[2] * sz + p.t[1];
-	const float gz = p.rz[0] * D + p.rz[1] * sy + p.rz[2] * sz + p.t[2];	// metres
-	// Written so that NaN fails every comparison.
-	const bool ok = (v > 0.f) & (v >= p.min_range) & (v <= p.max_range) & (gz >= p.z_min) &
-					(gz <= p.z_max) & (fx >= 0.f) & (fy >= 0.f) & (fx < p.nx) & (fy < p.ny);
-	// int() of a value outside the int range is UB: convert only in-grid values.
-	const int32_t cx = int32_t(ok ? fx : 0.f), cy = int32_t(ok ? fy : 0.f);
-	cell = ok ? cy * p.nx_cells + cx : -1;
-	z = gz;
-}
-
-// A full row: no branches and unit strides, so the compiler vectorizes it.
-template <bool kDepth>
-void projectRow(
-	const DepthProjector::RowParams& p, const uint16_t* __restrict row, const float* __restrict ky,
-	const float* __restrict kz, const float* __restrict invNorm, int cols, int32_t* __restrict cell,
-	float* __restrict z)
-{
-	for (int c = 0; c < cols; c++)
-		projectPixel<kDepth>(p, row[c], ky[c], kz[c], kDepth ? 1.f : invNorm[c], cell[c], z[c]);
-}
-
 void projectRowDecimated(
 	const DepthProjector::RowParams& p, bool isDepth, const uint16_t* row, const float* ky, const float* kz,
 	const float* invNorm, int cols, int dec, int32_t* cell, float* z)
@@ -167,6 +137,7 @@ size_t DepthProjector::project(
 	float* outZ = out.zBuffer();
 	size_t n = start;
 	int32_t* rowCell = m_rowCell.data();
+	const bool useAvx2 = m_allowAvx2 && avx2RowLoopAvailable();
 	float* rowZ = m_rowZ.data();
 
 	for (int r = 0; r < img.rows; r += dec)
@@ -175,11 +146,13 @@ size_t DepthProjector::project(
 		const uint16_t* row = img.data + size_t(r) * img.stride;
 		if (dec == 1)
 		{
-			if (img.is_depth)
-				projectRow<true>(p, row, &m_rayY[lutRow], &m_rayZ[lutRow], nullptr, img.cols, rowCell, rowZ);
+			const float* invN = img.is_depth ? nullptr : &m_rayInvNorm[lutRow];
+			if (useAvx2)
+				projectRowAvx2(img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
+			else if (img.is_depth)
+				projectRowLoop<true>(p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
 			else
-				projectRow<false>(
-					p, row, &m_rayY[lutRow], &m_rayZ[lutRow], &m_rayInvNorm[lutRow], img.cols, rowCell, rowZ);
+				projectRowLoop<false>(p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
 		}
 		else
 			projectRowDecimated(

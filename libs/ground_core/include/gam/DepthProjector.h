@@ -72,6 +72,10 @@ class DepthProjector
 		const RangeImageView& img, const PinholeIntrinsics& K, const RigidTransform& sensorToGrid,
 		const ProjectionFilter& f, const ElevationGrid& grid, BinnedPoints& out);
 
+	/** Use the AVX2 row loop where the CPU has it (default). Off: always the
+	 * baseline SSE2 loop; both give bit-identical results (tested). */
+	void setAllowAvx2(bool allow) { m_allowAvx2 = allow; }
+
 	/** Number of pixels in the ray table (that of the last intrinsics used). */
 	size_t rayTableSize() const { return m_rayY.size(); }
 	/** Ray factors (y/x, z/x) of pixel (row, col): the sensor-frame point of
@@ -99,6 +103,14 @@ class DepthProjector
 	// One row of results before compaction (cell or -1, z).
 	std::vector<int32_t> m_rowCell;
 	std::vector<float> m_rowZ;
+	bool m_allowAvx2 = true;
 };
+
+/** The row loop built for AVX2 (DepthProjectorAvx2.cpp) and whether this CPU
+ * and build can run it. Internal to DepthProjector. */
+bool avx2RowLoopAvailable();
+void projectRowAvx2(
+	bool isDepth, const DepthProjector::RowParams& p, const uint16_t* row, const float* ky, const float* kz,
+	const float* invNorm, int cols, int32_t* cell, float* z);
 
 }  // namespace gam
