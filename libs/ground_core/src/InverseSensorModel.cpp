@@ -308,12 +308,16 @@ void InverseSensorModel::compute(
 		}
 		const float p = m_evidence[idx];
 		const int steps = int(std::ceil(len / (0.5 * res)));
+		// March in cell units from the voxel back along the ray (no division per step).
+		const double vx = (x - g.x_min) / res, vy = (y - g.y_min) / res;
+		const double sx = lx / res, sy = ly / res;
 		int lastCell = -1;
 		for (int s = 1; s < steps; s++)
 		{
-			const double f = double(s) / steps;
-			const int qx = g.ix(x - lx * (1.0 - f)), qy = g.iy(y - ly * (1.0 - f));
-			if (!g.inside(qx, qy)) continue;
+			const double back = 1.0 - double(s) / steps;
+			const double fx = vx - sx * back, fy = vy - sy * back;
+			if (!(fx >= 0 && fy >= 0 && fx < g.nx && fy < g.ny)) continue;
+			const int qx = int(fx), qy = int(fy);
 			const int q = int(g.index(qx, qy));
 			if (q == lastCell || uint32_t(q) == idx) continue;
 			lastCell = q;
