@@ -1,5 +1,6 @@
 // End-to-end tests of ground-aware-mapper: run the real executable on a real
 // rawlog and on generated ones (both rawlog formats), and check every output.
+#include <gam/eval/Evaluation.h>
 #include <gam/mapper/GridIO.h>
 #include <gtest/gtest.h>
 #include <mrpt/img/CImage.h>
@@ -220,25 +221,26 @@ void checkOutputs(const std::string& dir)
 		const std::string base = dir + "/" + name;
 		for (const char* ext : {".yaml", ".pgm", ".gridmap.gz", ".png"})
 			ASSERT_TRUE(fs::exists(base + ext)) << base + ext;
-		const RosMapYaml y = readRosYaml(base + ".yaml");
-		const PgmImage pgm = readPgm(base + ".pgm");
+		// The evaluator's map_server reader (libs/evaluation), not the writer's code.
+		const gam::eval::RosMap y = gam::eval::loadRosMap(base + ".yaml");
 		const COccupancyGridMap2D g = readGridmapGz(base + ".gridmap.gz");
-		EXPECT_EQ(y.image, name + ".pgm");
+		EXPECT_EQ(fs::path(y.imagePath).filename().string(), name + ".pgm");
 		EXPECT_EQ(y.mode, "scale");
 		EXPECT_EQ(y.negate, 0);
 		EXPECT_NEAR(y.resolution, g.getResolution(), 1e-6);
 		EXPECT_NEAR(y.origin_x, g.getXMin(), 1e-4);
 		EXPECT_NEAR(y.origin_y, g.getYMin(), 1e-4);
-		ASSERT_EQ(pgm.width, int(g.getSizeX()));
-		ASSERT_EQ(pgm.height, int(g.getSizeY()));
+		ASSERT_EQ(y.width, int(g.getSizeX()));
+		ASSERT_EQ(y.height, int(g.getSizeY()));
 		size_t bad = 0, occupied = 0;
-		for (int row = 0; row < pgm.height; row++)
-			for (int x = 0; x < pgm.width; x++)
+		for (int row = 0; row < y.height; row++)
+			for (int x = 0; x < y.width; x++)
 			{
-				const int cy = pgm.height - 1 - row;  // first row = highest y
+				const int cy = y.height - 1 - row;  // first row = highest y
 				const double pOcc = 1.0 - double(g.getCell(x, cy));
 				const int expect = int(std::lround(255.0 * (1.0 - pOcc)));
-				if (std::abs(int(pgm.at(x, row)) - expect) > 0) bad++;
+				const int pixel = y.pixels[size_t(row) * size_t(y.width) + size_t(x)];
+				if (std::abs(pixel - expect) > 0) bad++;
 				if (pOcc > 0.6) occupied++;
 			}
 		EXPECT_EQ(bad, 0u) << "PGM pixels differ from round(255*(1-p_occ))";

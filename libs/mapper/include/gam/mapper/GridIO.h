@@ -53,24 +53,7 @@ mrpt::maps::COccupancyGridMap2D plainCopy(const mrpt::maps::COccupancyGridMap2D&
 bool recentreGrid(mrpt::maps::COccupancyGridMap2D& grid, double cx, double cy, int n);
 
 // --------------------------------------------------------------- readers
-struct PgmImage
-{
-	int width = 0, height = 0, maxval = 0;
-	std::vector<uint8_t> pixels;  ///< row-major, first row first
-	uint8_t at(int x, int row) const { return pixels[size_t(row) * size_t(width) + size_t(x)]; }
-};
-/** Reads a binary (P5) PGM; throws std::runtime_error. */
-PgmImage readPgm(const std::string& path);
-
-struct RosMapYaml
-{
-	std::string image, mode;
-	double resolution = 0, origin_x = 0, origin_y = 0, origin_yaw = 0;
-	int negate = -1;
-	double occupied_thresh = -1, free_thresh = -1;
-};
-/** Reads the keys of a map_server YAML; throws std::runtime_error if one is missing. */
-RosMapYaml readRosYaml(const std::string& path);
+// (map_server yaml + PGM: gam::eval::loadRosMap in libs/evaluation.)
 
 /** Reads a .gridmap / .gridmap.gz as a stock COccupancyGridMap2D. */
 mrpt::maps::COccupancyGridMap2D readGridmapGz(const std::string& path);
