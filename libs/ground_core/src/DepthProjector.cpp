@@ -35,15 +35,21 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 	m_rayInvNorm.resize(n);
 	m_rowCell.resize(size_t(K.width));
 	m_rowZ.resize(size_t(K.width));
+	const bool distorted = K.k1 != 0 || K.k2 != 0 || K.k3 != 0 || K.p1 != 0 || K.p2 != 0;
 	for (int r = 0; r < K.height; r++)
+	{
+		// The undistortion correction changes little from one pixel to the next:
+		// starting from the left neighbour's cuts the iterations (and the first
+		// frame of a camera, which builds this table) several-fold.
+		double corrX = 0, corrY = 0;
 		for (int c = 0; c < K.width; c++)
 		{
 			// MRPT's convention (CObservation3DRangeScan::unprojectInto):
 			// x = D, y = (cx - c) * D / fx, z = (cy - r) * D / fy, with (c, r)
 			// first undistorted. Normalized image coordinates (right, down):
 			const double xd = (c - K.cx) / K.fx, yd = (r - K.cy) / K.fy;
-			double xu = xd, yu = yd;
-			if (K.k1 != 0 || K.k2 != 0 || K.k3 != 0 || K.p1 != 0 || K.p2 != 0)
+			double xu = xd + corrX, yu = yd + corrY;
+			if (distorted)
 			{
 				// Invert the distortion by fixed-point iteration (converges in a
 				// few steps for the mild distortion of depth cameras).
@@ -59,6 +65,8 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 					yu = ny;
 					if (done) break;
 				}
+				corrX = xu - xd;
+				corrY = yu - yd;
 			}
 			const float ky = float(-xu), kz = float(-yu);
 			const size_t i = size_t(r) * size_t(K.width) + size_t(c);
@@ -66,6 +74,7 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 			m_rayZ[i] = kz;
 			m_rayInvNorm[i] = 1.0f / std::sqrt(1.0f + ky * ky + kz * kz);
 		}
+	}
 }
 
 namespace
