@@ -89,7 +89,7 @@ void BM_Projection(benchmark::State& st, const Dataset* d)
 	gam::DepthProjector proj;
 	gam::BinnedPoints bins;
 	gam::mrpt_glue::BinningOptions bo;
-	size_t i = 0;
+	size_t i = 0, samples = 0, n = 0;
 	for (auto _ : st)
 	{
 		const Frame& f = d->frames[i++ % d->frames.size()];
@@ -98,7 +98,10 @@ void BM_Projection(benchmark::State& st, const Dataset* d)
 		bins.clear();
 		gam::mrpt_glue::binObservation(*f.depth, f.pose, bo, frame, proj, bins);
 		benchmark::DoNotOptimize(bins.size());
+		samples += bins.size();
+		n++;
 	}
+	st.counters["samples/frame"] = n ? double(samples) / double(n) : 0;
 }
 
 void BM_OutlierFilter(benchmark::State& st, const Dataset* d)
