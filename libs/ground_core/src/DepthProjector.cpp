@@ -146,8 +146,8 @@ size_t DepthProjector::project(
 	float* outZ = out.zBuffer();
 	size_t n = start;
 	int32_t* rowCell = m_rowCell.data();
-	const bool useAvx2 = m_allowAvx2 && avx2RowLoopAvailable();
 	float* rowZ = m_rowZ.data();
+	const bool useAvx2 = m_allowAvx2 && avx2RowLoopAvailable();
 
 	for (int r = 0; r < img.rows; r += dec)
 	{
@@ -158,10 +158,8 @@ size_t DepthProjector::project(
 			const float* invN = img.is_depth ? nullptr : &m_rayInvNorm[lutRow];
 			if (useAvx2)
 				projectRowAvx2(img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
-			else if (img.is_depth)
-				projectRowLoop<true>(p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
 			else
-				projectRowLoop<false>(p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
+				projectRow(img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
 		}
 		else
 			projectRowDecimated(
@@ -178,8 +176,7 @@ size_t DepthProjector::project(
 		}
 	}
 	out.commit(n);
-	const size_t binned = n - start;
-	return binned;
+	return n - start;
 }
 
 }  // namespace gam

@@ -17,10 +17,7 @@ void projectRowAvx2(
 	bool isDepth, const DepthProjector::RowParams& p, const uint16_t* row, const float* ky, const float* kz,
 	const float* invNorm, int cols, int32_t* cell, float* z)
 {
-	if (isDepth)
-		projectRowLoop<true>(p, row, ky, kz, invNorm, cols, cell, z);
-	else
-		projectRowLoop<false>(p, row, ky, kz, invNorm, cols, cell, z);
+	projectRow(isDepth, p, row, ky, kz, invNorm, cols, cell, z);
 }
 #else
 bool avx2RowLoopAvailable() { return false; }

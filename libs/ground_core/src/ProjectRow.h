@@ -44,5 +44,16 @@ void projectRowLoop(
 	for (int c = 0; c < cols; c++)
 		projectPixel<kDepth>(p, row[c], ky[c], kz[c], kDepth ? 1.f : invNorm[c], cell[c], z[c]);
 }
+
+// The row loop for a depth image (invNorm unused) or a range image.
+inline void projectRow(
+	bool isDepth, const DepthProjector::RowParams& p, const uint16_t* row, const float* ky, const float* kz,
+	const float* invNorm, int cols, int32_t* cell, float* z)
+{
+	if (isDepth)
+		projectRowLoop<true>(p, row, ky, kz, invNorm, cols, cell, z);
+	else
+		projectRowLoop<false>(p, row, ky, kz, invNorm, cols, cell, z);
+}
 }  // namespace
 }  // namespace gam

@@ -157,10 +157,7 @@ void RrtGroundDetector::detect(
 	const ElevationGrid& grid, const GroundSeedHint& hint, GroundDetection& out)
 {
 	m_params.validate();
-	out.nodes.clear();
-	out.planes.clear();
-	out.plane_support.clear();
-	out.iterations = 0;
+	out.clear();
 	if (grid.observedCount() == 0)
 	{
 		out.status = GroundDetection::Status::EmptyGrid;
@@ -424,11 +421,11 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 	out.plane_support.reserve(size_t(m_params.max_planes));
 
 	// Keeps the remaining nodes whose m_flag is 0, in order.
-	auto keepUnflagged = [this]() {
+	auto keepUnflagged = [&]() {
 		m_rest.clear();
-		for (size_t i = 0; i < m_remaining.size(); i++)
-			if (!m_flag[i]) m_rest.push_back(m_remaining[i]);
-		m_remaining.swap(m_rest);
+		for (size_t i = 0; i < remaining.size(); i++)
+			if (!m_flag[i]) m_rest.push_back(remaining[i]);
+		remaining.swap(m_rest);
 	};
 
 	for (int k = 0; k < m_params.max_planes && remaining.size() >= 3; k++)
@@ -439,22 +436,22 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		pts.clear();
 		for (size_t i : remaining) pts.emplace_back(out.nodes[i].x, out.nodes[i].y, out.nodes[i].z);
 		if (!fitPlaneRansac(pts, rp, m_rng, m_ransac, m_ransacInliers)) break;
-		const RansacResult* r = &m_ransac;
+		const RansacResult& r = m_ransac;
 
-		Plane plane = r->plane;
+		Plane plane = r.plane;
 		// Nearly collinear node sets (a corridor crossed by one line of nodes)
 		// leave the roll about that line undetermined: take the mean of the
 		// inliers' local normals instead, which every node measured itself.
 		Eigen::Vector2d mean2 = Eigen::Vector2d::Zero();
-		for (size_t i : r->inliers) mean2 += pts[i].head<2>();
-		mean2 /= double(r->inliers.size());
+		for (size_t i : r.inliers) mean2 += pts[i].head<2>();
+		mean2 /= double(r.inliers.size());
 		Eigen::Matrix2d C = Eigen::Matrix2d::Zero();
-		for (size_t i : r->inliers)
+		for (size_t i : r.inliers)
 		{
 			const Eigen::Vector2d d = pts[i].head<2>() - mean2;
 			C += d * d.transpose();
 		}
-		C /= double(r->inliers.size());
+		C /= double(r.inliers.size());
 		const double minorStd = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(C).eigenvalues()(0)));
 		// An extra patch must be an area, not a line of nodes along the top of
 		// a cable protector or a kerb: those are obstacles, not ground.
@@ -462,26 +459,26 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		if (k > 0 && lineLike)
 		{
 			m_flag.assign(remaining.size(), 0);
-			for (size_t i : r->inliers) m_flag[i] = 1;
+			for (size_t i : r.inliers) m_flag[i] = 1;
 			keepUnflagged();
 			continue;
 		}
 		if (minorStd < 0.5 * m_params.expansion_distance)
 		{
 			Eigen::Vector3d n = Eigen::Vector3d::Zero(), c = Eigen::Vector3d::Zero();
-			for (size_t i : r->inliers)
+			for (size_t i : r.inliers)
 			{
 				n += out.nodes[remaining[i]].local.normal();
 				c += pts[i];
 			}
-			plane = Plane::fromNormalAndPoint(n, c / double(r->inliers.size()));
+			plane = Plane::fromNormalAndPoint(n, c / double(r.inliers.size()));
 		}
 
 		const int id = int(out.planes.size());
 		out.planes.push_back(plane);
-		out.plane_support.push_back(r->inliers.size());
+		out.plane_support.push_back(r.inliers.size());
 		m_flag.assign(remaining.size(), 0);
-		for (size_t i : r->inliers)
+		for (size_t i : r.inliers)
 		{
 			m_flag[i] = 1;
 			out.nodes[remaining[i]].plane_id = id;

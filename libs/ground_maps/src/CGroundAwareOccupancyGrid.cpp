@@ -386,20 +386,10 @@ void CGroundAwareOccupancyGrid::resetLastFrame()
 {
 	// As m_last = TFrameDiagnostics{}, but the detection's vectors keep their
 	// capacity: no heap allocation per frame once they have grown (issue #6).
-	gam::GroundDetection& d = m_last.detection;
-	std::vector<gam::GroundNode> nodes;
-	std::vector<gam::Plane> planes;
-	std::vector<size_t> support;
-	nodes.swap(d.nodes);
-	planes.swap(d.planes);
-	support.swap(d.plane_support);
+	gam::GroundDetection detection = std::move(m_last.detection);
 	m_last = TFrameDiagnostics{};
-	nodes.clear();
-	planes.clear();
-	support.clear();
-	m_last.detection.nodes.swap(nodes);
-	m_last.detection.planes.swap(planes);
-	m_last.detection.plane_support.swap(support);
+	detection.clear();
+	m_last.detection = std::move(detection);
 }
 
 void CGroundAwareOccupancyGrid::applyEvidence()

@@ -86,6 +86,16 @@ struct GroundDetection
 
 	bool ok() const { return status == Status::Ok; }
 	const Plane& plane() const { return planes.front(); }
+	/** Back to the default state; the vectors keep their capacity, so reusing
+	 * one GroundDetection frame after frame allocates nothing. */
+	void clear()
+	{
+		status = Status::EmptyGrid;
+		planes.clear();
+		plane_support.clear();
+		nodes.clear();
+		iterations = 0;
+	}
 	static const char* statusName(Status s);
 	std::string describe() const;
 };
