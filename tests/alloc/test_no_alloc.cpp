@@ -25,6 +25,7 @@
 #include <new>
 #include <random>
 
+#include "../maps/real_data.h"
 #include "../maps/synthetic_scene.h"
 #include "gam/ElevationGrid.h"
 #include "gam/InverseSensorModel.h"
@@ -190,23 +191,8 @@ struct TraceSetup
 	}
 } g_traceSetup;
 
-std::string realData(const std::string& rel) { return std::string(GAM_REAL_DATA_DIR) + "/" + rel; }
-
-CObservation3DRangeScan::Ptr firstScan(const std::string& rel)
-{
-	const std::string file = realData(rel);
-	if (!mrpt::system::fileExists(file)) return {};
-	mrpt::obs::CRawlog rl;
-	if (!rl.loadFromRawLogFile(file)) return {};
-	for (size_t i = 0; i < rl.size(); i++)
-		if (rl.getType(i) == mrpt::obs::CRawlog::etObservation)
-			if (auto o = std::dynamic_pointer_cast<CObservation3DRangeScan>(rl.getAsObservation(i)))
-			{
-				o->load();
-				return o;
-			}
-	return {};
-}
+using testdata::firstScan;
+using testdata::realData;
 
 // Floor with a 10 cm box and a hole, seen by a Kinect 1 m up pitched 25 deg
 // down: ground, obstacle, drop and drop-ray evidence, like tests/maps.

@@ -7,29 +7,16 @@
 #include <mrpt/obs/CRawlog.h>
 #include <mrpt/system/filesystem.h>
 
+#include "real_data.h"
+
 using namespace mrpt::maps;
 using namespace mrpt::obs;
 using mrpt::DEG2RAD;
 
 namespace
 {
-std::string realData(const std::string& rel) { return std::string(GAM_REAL_DATA_DIR) + "/" + rel; }
-
-CObservation3DRangeScan::Ptr firstScan(const std::string& rel)
-{
-	const std::string file = realData(rel);
-	if (!mrpt::system::fileExists(file)) return {};
-	CRawlog rl;
-	if (!rl.loadFromRawLogFile(file)) return {};
-	for (size_t i = 0; i < rl.size(); i++)
-		if (rl.getType(i) == CRawlog::etObservation)
-			if (auto o = std::dynamic_pointer_cast<CObservation3DRangeScan>(rl.getAsObservation(i)))
-			{
-				o->load();
-				return o;
-			}
-	return {};
-}
+using testdata::firstScan;
+using testdata::realData;
 
 #define LOAD_OR_SKIP(var, rel)                                                        \
 	auto var = firstScan(rel);                                                        \
