@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "gam/DepthProjector.h"
+#include "gam/core/DepthProjector.h"
 #include "test_helpers.h"
 
 using namespace gam;
@@ -546,7 +546,7 @@ TEST(DepthProjector, LensDistortionIsInvertedInTheRayTable)
 
 TEST(DepthProjector, Avx2AndBaselineRowLoopsAgreeBitForBit)
 {
-	if (!avx2RowLoopAvailable()) GTEST_SKIP() << "no AVX2 on this CPU or build";
+	if (!DepthProjector::avx2Available()) GTEST_SKIP() << "no AVX2 on this CPU or build";
 	// Random depths (some 0, some beyond the range, odd widths that leave a
 	// scalar tail), a pitched, rolled camera, range and depth images, distortion.
 	std::mt19937 rng(7);

@@ -7,7 +7,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "gam/ElevationGrid.h"
+#include "gam/core/ElevationGrid.h"
 #include "test_helpers.h"
 
 using namespace gam;

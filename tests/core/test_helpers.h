@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "gam/ElevationGrid.h"
+#include "gam/core/ElevationGrid.h"
 
 namespace gamtest
 {

@@ -9,8 +9,8 @@
 #include <set>
 #include <stdexcept>
 
-#include "gam/InverseSensorModel.h"
-#include "gam/RrtGroundDetector.h"
+#include "gam/core/InverseSensorModel.h"
+#include "gam/core/RrtGroundDetector.h"
 #include "test_helpers.h"
 
 using namespace gam;
@@ -140,14 +140,17 @@ TEST(IsmParamsTest, ValidateAndDefaults)
 	EXPECT_THROW(bad([](IsmParams& p) { p.K_m = 1.0; }).validate(), std::invalid_argument);
 	EXPECT_THROW(bad([](IsmParams& p) { p.noise_sigmas = -1; }).validate(), std::invalid_argument);
 	EXPECT_THROW(bad([](IsmParams& p) { p.robot_height = 0; }).validate(), std::invalid_argument);
-	EXPECT_THROW(bad([](IsmParams& p) { p.max_range = 0; }).validate(), std::invalid_argument);
 	EXPECT_THROW(bad([](IsmParams& p) { p.max_drop_ray_length = -1; }).validate(), std::invalid_argument);
 
-	// compute() validates too.
-	InverseSensorModel ism(bad([](IsmParams& p) { p.K_m = 2; }));
+	// Parameters are checked when they are set, not on every frame.
+	EXPECT_THROW(InverseSensorModel{bad([](IsmParams& p) { p.K_m = 2; })}, std::invalid_argument);
+	InverseSensorModel ism;
+	EXPECT_THROW(ism.setParams(bad([](IsmParams& p) { p.K_m = 2; })), std::invalid_argument);
+	EXPECT_DOUBLE_EQ(ism.params().K_m, 0.8);
+	// The sensor's range is an input of each frame.
 	ElevationGrid grid;
 	IsmStats st;
-	EXPECT_THROW(ism.compute(grid, handDetection(kFloor), {0, 0, 1}, st), std::invalid_argument);
+	EXPECT_THROW(ism.compute(grid, handDetection(kFloor), {0, 0, 1}, 0.0, st), std::invalid_argument);
 }
 
 TEST(InverseSensorModel, GroundBandNoiseModel)
@@ -255,11 +258,10 @@ TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
 	const ElevationGrid frame = sceneFrame();
 	const GridGeometry& g = frame.geometry();
 	IsmParams p;
-	p.max_range = 4.0;
 	p.min_obstacle_points = 1;	// the hole cells have one sample each (see LoneSamples... below)
 	InverseSensorModel ism(p);
 	IsmStats st;
-	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 4.0, st);  // max range 4 m
 	EXPECT_TRUE(st.applied);
 
 	const double pBox = handObstacleP(5, 0.4, 0.05);	 // rho 5000: 0.651016
@@ -336,9 +338,9 @@ TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
 	EXPECT_EQ(ism.evidenceCells().size(), nFloor + nBox + nHole + nShelf);
 	checkEvidenceBookkeeping(ism);
 
-	// With the default max_range (5 m) the far box counts.
+	// With a 5 m max range the far box counts.
 	ism.setParams(IsmParams{});
-	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	EXPECT_EQ(st.out_of_range, 0u);
 	EXPECT_EQ(st.obstacle, nBox + nShelf + nFar);
 	EXPECT_GT(ism.evidence()[g.index(g.ix(4.25), g.iy(0.05))], 0.5f);
@@ -351,7 +353,7 @@ TEST(InverseSensorModel, GroundEvidenceFollowsPlaneDistance)
 	const ElevationGrid frame = sceneFrame();
 	InverseSensorModel ism;
 	IsmStats st;
-	ism.compute(frame, handDetection(Plane{0, 0, 1, -0.01}), {0, 0, 1}, st);
+	ism.compute(frame, handDetection(Plane{0, 0, 1, -0.01}), {0, 0, 1}, 5.0, st);
 	const GridGeometry& g = frame.geometry();
 	const size_t i = g.index(g.ix(1.0), g.iy(0.0));
 	EXPECT_EQ(ism.classes()[i], VoxelClass::Ground);
@@ -364,14 +366,14 @@ TEST(InverseSensorModel, NoPlaneNeverInventsObstacles)
 	InverseSensorModel ism;
 	IsmStats st;
 	// First a normal frame, so that there is evidence to forget.
-	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	ASSERT_FALSE(ism.evidenceCells().empty());
 
 	for (auto s : {GroundDetection::Status::EmptyGrid, GroundDetection::Status::NoValidSeed,
 				   GroundDetection::Status::TooFewNodes, GroundDetection::Status::NoConsensus})
 	{
 		// Even with a plane in the result, a failed detection produces nothing.
-		ism.compute(frame, handDetection(kFloor, s), {0, 0, 1}, st);
+		ism.compute(frame, handDetection(kFloor, s), {0, 0, 1}, 5.0, st);
 		EXPECT_FALSE(st.applied);
 		EXPECT_TRUE(ism.evidenceCells().empty()) << GroundDetection::statusName(s);
 		EXPECT_EQ(st.obstacle + st.ground + st.drop + st.overhead + st.out_of_range, 0u);
@@ -381,7 +383,7 @@ TEST(InverseSensorModel, NoPlaneNeverInventsObstacles)
 	// Status Ok but no plane: nothing either.
 	GroundDetection none;
 	none.status = GroundDetection::Status::Ok;
-	ism.compute(frame, none, {0, 0, 1}, st);
+	ism.compute(frame, none, {0, 0, 1}, 5.0, st);
 	EXPECT_FALSE(st.applied);
 	EXPECT_TRUE(ism.evidenceCells().empty());
 
@@ -395,7 +397,7 @@ TEST(InverseSensorModel, NoPlaneNeverInventsObstacles)
 	GroundDetection out;
 	det.detect(table, {0, 0, 0}, out);
 	ASSERT_EQ(out.status, GroundDetection::Status::NoValidSeed);
-	ism.compute(table, out, {0, 0, 1}, st);
+	ism.compute(table, out, {0, 0, 1}, 5.0, st);
 	EXPECT_TRUE(ism.evidenceCells().empty());
 }
 
@@ -431,7 +433,7 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	IsmStats st;
 	// By default a drop voxel needs 3 samples to cast a ray: these have one.
 	InverseSensorModel strict(prm);
-	strict.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	strict.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	EXPECT_EQ(st.drop, 18u * 20u);
 	EXPECT_EQ(st.drop_ray_cells, 0u);
 	prm.drop_ray_min_points = 1;
@@ -439,7 +441,7 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	// Sensor 1 m above the plane at the origin: the ray to a voxel at (x, y,
 	// -0.3) crosses z = 0 at 1/1.3 of the way, e.g. x = 2.625 -> 2.019 and
 	// x = 3.475 -> 2.673.
-	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	const double pDrop = handObstacleP(1, 0.0, 0.05);
 	EXPECT_EQ(st.drop, 18u * 20u);
 	EXPECT_GT(st.drop_ray_cells, 0u);
@@ -479,7 +481,7 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	p.drop_ray_min_points = 1;
 	p.max_drop_ray_length = 0.2;
 	ism.setParams(p);
-	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.15), g.iy(0.2))], 0.5f);
 	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.35), g.iy(0.2))], 0.5f);
 	EXPECT_NEAR(ism.evidence()[g.index(g.ix(2.55), g.iy(0.2))], pDrop, 1e-6);
@@ -487,7 +489,7 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	// Disabled: the gap stays unknown, the drop voxels still count.
 	p.drop_rays = false;
 	ism.setParams(p);
-	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	EXPECT_EQ(st.drop_ray_cells, 0u);
 	EXPECT_EQ(st.drop, 18u * 20u);
 	for (int cx = g.ix(1.5); cx < g.ix(2.6); cx++)
@@ -506,7 +508,7 @@ TEST(InverseSensorModel, DropRayMinPoints)
 	InverseSensorModel ism(p);
 	IsmStats st;
 	const ElevationGrid three = stepFrame(3);
-	ism.compute(three, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(three, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	EXPECT_EQ(st.drop, 18u * 20u);
 	EXPECT_GT(st.drop_ray_cells, 50u);
 	const GridGeometry& g = three.geometry();
@@ -515,7 +517,7 @@ TEST(InverseSensorModel, DropRayMinPoints)
 	EXPECT_NEAR(ism.evidence()[g.index(g.ix(2.4), g.iy(0.0))], p3, 1e-6);
 
 	const ElevationGrid two = stepFrame(2);
-	ism.compute(two, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(two, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	EXPECT_EQ(st.drop, 18u * 20u);
 	EXPECT_EQ(st.drop_ray_cells, 0u);
 	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.4), g.iy(0.0))], 0.5f);
@@ -534,7 +536,7 @@ TEST(InverseSensorModel, NeutralEvidenceIsNeverListed)
 	p.min_obstacle_points = 1;
 	InverseSensorModel ism(p);
 	IsmStats st;
-	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	EXPECT_GT(st.ground, 0u);
 	EXPECT_GT(st.drop, 0u);
 	EXPECT_GT(st.drop_ray_cells, 0u);  // the rays did run (over the gap)
@@ -544,7 +546,7 @@ TEST(InverseSensorModel, NeutralEvidenceIsNeverListed)
 	// Only K_m = 0: the floor is listed (free), the drops and rays are not.
 	p.K_g = 0.3;
 	ism.setParams(p);
-	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	EXPECT_EQ(ism.evidenceCells().size(), st.ground);
 	checkEvidenceBookkeeping(ism);
 }
@@ -567,7 +569,7 @@ TEST(InverseSensorModel, RampIsGroundOnlyWithLocalPlanes)
 		p.local_planes = local;
 		InverseSensorModel ism(p);
 		IsmStats st;
-		ism.compute(grid, out, sensor, st);
+		ism.compute(grid, out, sensor, 5.0, st);
 		size_t n = 0, ng = 0, no = 0, nf = 0, nfg = 0;
 		for (uint32_t idx : grid.observedCells())
 		{
@@ -616,15 +618,14 @@ TEST(InverseSensorModel, LoneSamplesGiveNoObstacleEvidence)
 	const ElevationGrid frame = sceneFrame();
 	const GridGeometry& g = frame.geometry();
 	IsmParams p;
-	p.max_range = 4.0;
 	ASSERT_EQ(p.min_obstacle_points, 2);
 	InverseSensorModel ism(p);
 	IsmStats st;
-	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, st);
+	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 4.0, st);
 	EXPECT_EQ(st.sparse, 4u);
 	EXPECT_EQ(st.drop, 0u);
 	EXPECT_EQ(ism.evidence()[g.index(g.ix(1.55), g.iy(-0.45))], 0.5f);
 	EXPECT_GT(ism.evidence()[g.index(g.ix(1.25), g.iy(0.55))], 0.5f);
 	p.min_obstacle_points = 0;
-	EXPECT_THROW(InverseSensorModel(p).compute(frame, handDetection(kFloor), {0, 0, 1}, st), std::invalid_argument);
+	EXPECT_THROW(InverseSensorModel{p}, std::invalid_argument);
 }

@@ -1,15 +1,17 @@
 // Ground-aware mapping for MRPT
-// The whole pure pipeline on a ray-cast depth image: projector -> 2.5D grid
-// (3-sigma filter) -> RRT-GPD -> ISM.
+// The whole pure pipeline (gam::GroundAwarePipeline) on a ray-cast depth
+// image: projector -> 2.5D grid (3-sigma filter, IDW) -> RRT-GPD -> ISM; and
+// its parameter table.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 
-#include "gam/DepthProjector.h"
-#include "gam/InverseSensorModel.h"
-#include "gam/RrtGroundDetector.h"
+#include <set>
+#include <string>
+
+#include "gam/core/GroundAwarePipeline.h"
 #include "test_helpers.h"
 
 using namespace gam;
@@ -77,23 +79,28 @@ TEST(Pipeline, DepthImageOfFloorAndBoxToEvidence)
 			// t is the depth along the sensor X axis since ray.x() = 1.
 			if (std::isfinite(t) && t < 4.5) depth[size_t(r * K.width + c)] = uint16_t(std::lround(t * 1000));
 		}
-	RangeImageView img;
-	img.data = depth.data();
-	img.rows = K.height;
-	img.cols = K.width;
-	img.stride = size_t(K.width);
-	RigidTransform T;
-	T.R = R.cast<float>();
-	T.t = camPos.cast<float>();
+	SensorFrame frame;
+	frame.has_image = true;
+	frame.image.data = depth.data();
+	frame.image.rows = K.height;
+	frame.image.cols = K.width;
+	frame.image.stride = size_t(K.width);
+	frame.intrinsics = K;
+	frame.sensor_to_map.R = R.cast<float>();
+	frame.sensor_to_map.t = camPos.cast<float>();
+	frame.sensor_position = camPos;
 
-	ElevationGrid grid(gamtest::makeGeometry(-1, -3, 0.05, 120, 120));  // x in [-1, 5)
-	DepthProjector proj;
-	BinnedPoints pts;
-	ProjectionFilter f;
-	const size_t n = proj.project(img, K, T, f, grid, pts);
-	ASSERT_GT(n, 10000u);
-	grid.insert(pts, OutlierFilterParams{});
+	PipelineParams params;
+	params.m_x = params.m_y = 240;	// x, y in [-6, 6): everything the camera sees up to 4.5 m
+	GroundAwarePipeline pipeline(params);
+	const FrameResult& res = pipeline.process(frame, Eigen::Vector3d(0, 0, 0), GridLattice{0, 0, 0.05});
+	ASSERT_TRUE(res.valid);
+	ASSERT_GT(res.points, 10000u);
+	const ElevationGrid& grid = pipeline.frameGrid();
 	const GridGeometry& g = grid.geometry();
+	// Centred on the robot, on the lattice through (0, 0).
+	EXPECT_DOUBLE_EQ(g.x_min, -6.0);
+	EXPECT_DOUBLE_EQ(g.y_min, -6.0);
 
 	// The box top cells hold heights ~0.3, the floor ~0.
 	const ElevationCell& top = grid.cell(g.ix(1.75), g.iy(0.0));
@@ -103,16 +110,13 @@ TEST(Pipeline, DepthImageOfFloorAndBoxToEvidence)
 	ASSERT_TRUE(fl.observed());
 	EXPECT_NEAR(fl.mean(), 0.0, 0.002);
 
-	RrtGroundDetector det;
-	GroundDetection gd;
-	det.detect(grid, GroundSeedHint{0, 0, 0}, gd);
+	const GroundDetection& gd = res.detection;
 	ASSERT_EQ(gd.status, GroundDetection::Status::Ok) << gd.describe();
 	EXPECT_NEAR(gd.plane().heightAt(1.0, 0.0), 0.0, 0.005);
 	EXPECT_LT(gd.plane().tiltAngle(), deg2rad(0.5));
 
-	InverseSensorModel ism;
-	IsmStats st;
-	ism.compute(grid, gd, camPos, st);
+	const IsmStats& st = res.ism;
+	const InverseSensorModel& ism = pipeline.ism();
 	EXPECT_TRUE(st.applied);
 	EXPECT_GT(st.ground, 500u);
 	EXPECT_GT(st.obstacle, 10u);
@@ -140,4 +144,73 @@ TEST(Pipeline, DepthImageOfFloorAndBoxToEvidence)
 	EXPECT_EQ(floorFree, floorCells);
 	// The floor hidden behind the box was not seen: no evidence at all.
 	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.3), g.iy(0.0))], 0.5f);
+}
+
+TEST(Pipeline, EveryParameterHasOneKeyAndOneRange)
+{
+	// Every key once, and every default inside its own range.
+	std::set<std::string> keys;
+	const PipelineParams defaults;
+	size_t n = 0;
+	PipelineParams::forEachParam(defaults, [&](const ParamInfo& info, const auto& v) {
+		n++;
+		EXPECT_TRUE(keys.insert(info.key).second) << "duplicate key " << info.key;
+		EXPECT_LE(info.lo, double(v)) << info.key;
+		EXPECT_GE(info.hi, double(v)) << info.key;
+	});
+	EXPECT_EQ(keys.size(), n);
+	// Paper Table I names are the keys.
+	for (const char* k : {"K", "N_th", "E_th", "s_x", "s_y", "m_x", "m_y", "d_n", "d_pth", "K_g", "sigma2", "K_n", "d_min", "K_m"})
+		EXPECT_EQ(keys.count(k), 1u) << k;
+	EXPECT_NO_THROW(defaults.validate());
+}
+
+TEST(Pipeline, ParametersAreCheckedWhenSetNotPerFrame)
+{
+	GroundAwarePipeline pipeline;
+	PipelineParams p;
+	// K_g = 0.5 would make a ground voxel certain to be free: out of [0, 0.499].
+	p.ism.K_g = 0.5;
+	try
+	{
+		pipeline.setParams(p);
+		FAIL() << "K_g=0.5 accepted";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("K_g=0.5 is out of range 0 to 0.499"), std::string::npos) << e.what();
+	}
+	EXPECT_DOUBLE_EQ(pipeline.params().ism.K_g, 0.3);  // the old ones are kept
+
+	// Rules between keys.
+	p = PipelineParams{};
+	p.projection.z_min = 1.0f;
+	p.projection.z_max = 0.5f;
+	EXPECT_THROW(pipeline.setParams(p), std::invalid_argument);
+	p = PipelineParams{};
+	p.rrt.neighbourhood_x = 4;
+	EXPECT_THROW(pipeline.setParams(p), std::invalid_argument);
+	p = PipelineParams{};
+	p.m_x = p.m_y = 20000;	// 4e8 cells > the 2.5D map's 67M-cell limit
+	EXPECT_THROW(pipeline.setParams(p), std::invalid_argument);
+
+	// A bad input frame is an error too, not silent garbage.
+	SensorFrame empty;
+	EXPECT_THROW(
+		pipeline.process(empty, Eigen::Vector3d(NAN, 0, 0), GridLattice{}), std::invalid_argument);
+	const FrameResult& r = pipeline.process(empty, Eigen::Vector3d(0, 0, 0), GridLattice{});
+	EXPECT_TRUE(r.valid);
+	EXPECT_EQ(r.points, 0u);
+	EXPECT_EQ(r.detection.status, GroundDetection::Status::EmptyGrid);
+	EXPECT_FALSE(r.ism.applied);
+}
+
+TEST(Pipeline, CropsAtRobotHeightInTheRobotFrame)
+{
+	PipelineParams p;
+	p.ism.robot_height = 1.2;
+	const ProjectionFilter f = p.projectionFilter(0.5);	 // robot floor at z = 0.5 in the map
+	EXPECT_FLOAT_EQ(f.z_min, 0.5f - 3.0f);	// z_min = -3 (robot frame)
+	EXPECT_FLOAT_EQ(f.z_max, 0.5f + 1.2f);	// min(z_max 2.5, robot_height 1.2)
+	EXPECT_FLOAT_EQ(f.max_range, 5.0f);
 }

@@ -7,7 +7,7 @@
 #include <iostream>
 #include <random>
 
-#include "gam/PlaneFit.h"
+#include "gam/core/PlaneFit.h"
 #include "test_helpers.h"
 
 using namespace gam;

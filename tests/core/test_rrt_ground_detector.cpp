@@ -7,7 +7,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "gam/RrtGroundDetector.h"
+#include "gam/core/RrtGroundDetector.h"
 #include "test_helpers.h"
 
 using namespace gam;
@@ -95,13 +95,14 @@ TEST(RrtGpdParams, ValidateRejectsOutOfRangeValues)
 	ok.max_planes = 8;
 	EXPECT_NO_THROW(ok.validate());
 
-	// detect() validates too.
+	// Parameters are checked when they are set, not on every frame: the
+	// detector refuses them and keeps its previous, valid ones.
 	RrtGpdParams p;
 	p.neighbourhood_x = 2;
-	RrtGroundDetector det(p);
-	ElevationGrid grid = floorWallBoxGrid();
-	GroundDetection out;
-	EXPECT_THROW(det.detect(grid, {}, out), std::invalid_argument);
+	EXPECT_THROW(RrtGroundDetector{p}, std::invalid_argument);
+	RrtGroundDetector det;
+	EXPECT_THROW(det.setParams(p), std::invalid_argument);
+	EXPECT_EQ(det.params().neighbourhood_x, 3);
 }
 
 TEST(RrtGroundDetector, FindsFloorNotWallOrBox)

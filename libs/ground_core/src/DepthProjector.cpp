@@ -1,4 +1,4 @@
-#include "gam/DepthProjector.h"
+#include "gam/core/DepthProjector.h"
 
 #include "ProjectRow.h"
 
@@ -80,7 +80,7 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 namespace
 {
 void projectRowDecimated(
-	const DepthProjector::RowParams& p, bool isDepth, const uint16_t* row, const float* ky, const float* kz,
+	const detail::RowParams& p, bool isDepth, const uint16_t* row, const float* ky, const float* kz,
 	const float* invNorm, int cols, int dec, int32_t* cell, float* z)
 {
 	for (int c = 0, k = 0; c < cols; c += dec, k++)
@@ -111,7 +111,7 @@ size_t DepthProjector::project(
 		throw std::invalid_argument("sensor pose is not finite");
 	updateLut(K);
 
-	RowParams p;
+	detail::RowParams p;
 	const GridGeometry& g = grid.geometry();
 	const float inv_res = float(1.0 / g.resolution);
 	// Work in cell units relative to the grid origin: floats stay precise far
@@ -147,7 +147,7 @@ size_t DepthProjector::project(
 	size_t n = start;
 	int32_t* rowCell = m_rowCell.data();
 	float* rowZ = m_rowZ.data();
-	const bool useAvx2 = m_allowAvx2 && avx2RowLoopAvailable();
+	const bool useAvx2 = m_allowAvx2 && detail::avx2RowLoopAvailable();
 
 	for (int r = 0; r < img.rows; r += dec)
 	{
@@ -157,7 +157,7 @@ size_t DepthProjector::project(
 		{
 			const float* invN = img.is_depth ? nullptr : &m_rayInvNorm[lutRow];
 			if (useAvx2)
-				projectRowAvx2(img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
+				detail::projectRowAvx2(img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
 			else
 				projectRow(img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
 		}
@@ -179,4 +179,16 @@ size_t DepthProjector::project(
 	return n - start;
 }
 
+}  // namespace gam
+
+namespace gam
+{
+bool DepthProjector::avx2Available() { return detail::avx2RowLoopAvailable(); }
+
+void ProjectionFilter::validate() const
+{
+	checkParamRanges(*this, "");
+	requireParams(z_min < z_max, "", "z_min must be < z_max");
+	requireParams(min_range < max_range, "", "min_range must be < max_range");
+}
 }  // namespace gam

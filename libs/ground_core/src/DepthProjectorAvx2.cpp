@@ -5,7 +5,7 @@
 // DepthProjector.cpp calls it only when the CPU has AVX2.
 #include "ProjectRow.h"
 
-namespace gam
+namespace gam::detail
 {
 #if defined(GAM_HAVE_AVX2_ROW_LOOP)
 bool avx2RowLoopAvailable()
@@ -14,7 +14,7 @@ bool avx2RowLoopAvailable()
 	return has;
 }
 void projectRowAvx2(
-	bool isDepth, const DepthProjector::RowParams& p, const uint16_t* row, const float* ky, const float* kz,
+	bool isDepth, const RowParams& p, const uint16_t* row, const float* ky, const float* kz,
 	const float* invNorm, int cols, int32_t* cell, float* z)
 {
 	projectRow(isDepth, p, row, ky, kz, invNorm, cols, cell, z);
@@ -22,9 +22,9 @@ void projectRowAvx2(
 #else
 bool avx2RowLoopAvailable() { return false; }
 void projectRowAvx2(
-	bool, const DepthProjector::RowParams&, const uint16_t*, const float*, const float*, const float*, int, int32_t*,
+	bool, const RowParams&, const uint16_t*, const float*, const float*, const float*, int, int32_t*,
 	float*)
 {
 }
 #endif
-}  // namespace gam
+}  // namespace gam::detail

@@ -1,4 +1,4 @@
-#include "gam/ElevationGrid.h"
+#include "gam/core/ElevationGrid.h"
 
 #include <algorithm>
 #include <stdexcept>

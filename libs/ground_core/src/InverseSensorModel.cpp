@@ -1,44 +1,14 @@
-#include "gam/InverseSensorModel.h"
+#include "gam/core/InverseSensorModel.h"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 namespace gam
 {
-namespace
-{
-void require(bool ok, const char* name, const char* range, double v)
-{
-	if (!ok)
-	{
-		std::ostringstream s;
-		s << name << " must be " << range << " (got " << v << ")";
-		throw std::invalid_argument(s.str());
-	}
-}
-}  // namespace
-
-void IsmParams::validate() const
-{
-	require(d_pth > 0 && d_pth < 10, "d_pth", "in (0, 10) m", d_pth);
-	require(K_g >= 0 && K_g < 0.5, "K_g", "in [0, 0.5)", K_g);
-	require(sigma2 > 0, "sigma2", "> 0 m^2", sigma2);
-	require(K_n > 0, "K_n", "> 0", K_n);
-	require(std::isfinite(d_min), "d_min", "finite", d_min);
-	require(K_m >= 0 && K_m < 1, "K_m", "in [0, 1)", K_m);
-	require(floor_noise_min_cells >= 1, "floor_noise_min_cells", ">= 1", floor_noise_min_cells);
-	require(depth_noise_c0 >= 0, "depth_noise_c0", ">= 0 m", depth_noise_c0);
-	require(depth_noise_c2 >= 0, "depth_noise_c2", ">= 0 1/m", depth_noise_c2);
-	require(noise_sigmas >= 0 && noise_sigmas <= 10, "noise_sigmas", "in [0, 10]", noise_sigmas);
-	require(robot_height > 0, "robot_height", "> 0 m", robot_height);
-	require(max_range > 0, "max_range", "> 0 m", max_range);
-	require(min_obstacle_points >= 1, "min_obstacle_points", ">= 1", min_obstacle_points);
-	require(drop_ray_min_points >= 1, "drop_ray_min_points", ">= 1", drop_ray_min_points);
-	require(max_drop_ray_length >= 0, "max_drop_ray_length", ">= 0 m", max_drop_ray_length);
-	require(plane_support_radius >= 0, "plane_support_radius", ">= 0 m", plane_support_radius);
-}
+void IsmParams::validate() const { checkParamRanges(*this, ""); }
 
 namespace ism
 {
@@ -82,7 +52,7 @@ void InverseSensorModel::measureFloorNoise(
 	// vertical scatter of the sensor at their range: their sample std. The
 	// median per range bin is robust to the odd obstacle cell among them.
 	const GridGeometry& g = frame.geometry();
-	const size_t nb = size_t(std::ceil((m_params.max_range + 1.0) / kNoiseBin));
+	const size_t nb = size_t(std::ceil((m_maxRange + 1.0) / kNoiseBin));
 	m_floorNoise.assign(nb, -1.f);
 	if (!m_params.measure_floor_noise || m_params.noise_sigmas <= 0) return;
 	m_noiseBin.clear();
@@ -194,10 +164,12 @@ const Plane& InverseSensorModel::choosePlane(
 }
 
 void InverseSensorModel::compute(
-	const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor,
+	const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, double maxRange,
 	IsmStats& stats)
 {
-	m_params.validate();
+	if (!(maxRange > 0) || !std::isfinite(maxRange))
+		throw std::invalid_argument("ISM: the sensor's max range must be > 0 (got " + std::to_string(maxRange) + ")");
+	m_maxRange = maxRange;
 	stats = IsmStats{};
 	const GridGeometry& g = frame.geometry();
 	if (m_evidence.size() != g.cellCount())
@@ -225,7 +197,7 @@ void InverseSensorModel::compute(
 
 	buildSupport(g, det);
 	measureFloorNoise(frame, det, sensor);
-	const double maxR2 = m_params.max_range * m_params.max_range;
+	const double maxR2 = m_maxRange * m_maxRange;
 	const double res = g.resolution;
 
 	// Pass 1: every observed voxel updates its own cell.

@@ -1,4 +1,4 @@
-#include "gam/PlaneFit.h"
+#include "gam/core/PlaneFit.h"
 
 #include <Eigen/Dense>
 #include <cmath>

@@ -7,16 +7,35 @@
 
 #include <cstdint>
 
-#include "gam/DepthProjector.h"
+#include "gam/core/DepthProjector.h"
 
 namespace gam
 {
+namespace detail
+{
+/** The per-frame constants of the pixel loop (cell units in x and y). */
+struct RowParams
+{
+	float rx[3], ry[3], rz[3], t[3];
+	float min_range, max_range, z_min, z_max, nx, ny, units;
+	int32_t nx_cells;
+};
+
+/** The row loop built for AVX2 (DepthProjectorAvx2.cpp) and whether this CPU
+ * and build can run it. */
+bool avx2RowLoopAvailable();
+void projectRowAvx2(
+	bool isDepth, const RowParams& p, const uint16_t* row, const float* ky, const float* kz, const float* invNorm,
+	int cols, int32_t* cell, float* z);
+}  // namespace detail
+
 namespace
 {
+using detail::RowParams;
 // One pixel: its grid cell (-1 if it is dropped) and its height.
 template <bool kDepth>
 inline void projectPixel(
-	const DepthProjector::RowParams& p, uint16_t raw, float ky, float kz, float invNorm, int32_t& cell, float& z)
+	const RowParams& p, uint16_t raw, float ky, float kz, float invNorm, int32_t& cell, float& z)
 {
 	const float v = float(raw) * p.units;  // 0 = no return: fails v > 0 below
 	const float D = kDepth ? v : v * invNorm;
@@ -37,7 +56,7 @@ inline void projectPixel(
 // A full row: no branches and unit strides, so the compiler vectorizes it.
 template <bool kDepth>
 void projectRowLoop(
-	const DepthProjector::RowParams& p, const uint16_t* __restrict row, const float* __restrict ky,
+	const RowParams& p, const uint16_t* __restrict row, const float* __restrict ky,
 	const float* __restrict kz, const float* __restrict invNorm, int cols, int32_t* __restrict cell,
 	float* __restrict z)
 {
@@ -47,7 +66,7 @@ void projectRowLoop(
 
 // The row loop for a depth image (invNorm unused) or a range image.
 inline void projectRow(
-	bool isDepth, const DepthProjector::RowParams& p, const uint16_t* row, const float* ky, const float* kz,
+	bool isDepth, const RowParams& p, const uint16_t* row, const float* ky, const float* kz,
 	const float* invNorm, int cols, int32_t* cell, float* z)
 {
 	if (isDepth)

@@ -1,4 +1,4 @@
-#include "gam/RrtGroundDetector.h"
+#include "gam/core/RrtGroundDetector.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -9,39 +9,14 @@
 
 namespace gam
 {
-namespace
-{
-void require(bool ok, const char* name, const std::string& range, double v)
-{
-	if (!ok)
-	{
-		std::ostringstream s;
-		s << name << " must be " << range << " (got " << v << ")";
-		throw std::invalid_argument(s.str());
-	}
-}
-}  // namespace
-
 void RrtGpdParams::validate() const
 {
-	require(iterations >= 1 && iterations <= 1000000, "K (iterations)", "in [1, 1000000]", iterations);
-	require(normal_threshold > 0 && normal_threshold <= 1, "N_th (normal_threshold)", "in (0, 1]", normal_threshold);
-	require(elevation_threshold > 0 && elevation_threshold < 10, "E_th (elevation_threshold)", "in (0, 10) m", elevation_threshold);
+	checkParamRanges(*this, "");
 	// A plane needs a 2D neighbourhood: 1 x N cells are collinear.
-	require(neighbourhood_x >= 3 && neighbourhood_x <= 31 && neighbourhood_x % 2 == 1, "s_x (neighbourhood_x)", "odd, in [3, 31]", neighbourhood_x);
-	require(neighbourhood_y >= 3 && neighbourhood_y <= 31 && neighbourhood_y % 2 == 1, "s_y (neighbourhood_y)", "odd, in [3, 31]", neighbourhood_y);
-	require(expansion_distance > 0 && expansion_distance < 100, "d_n (expansion_distance)", "in (0, 100) m", expansion_distance);
-	require(max_cell_std > 0, "max_cell_std", "> 0 m", max_cell_std);
-	require(max_fit_rms > 0, "max_fit_rms", "> 0 m", max_fit_rms);
-	require(min_valid_cells >= 3 && min_valid_cells <= neighbourhood_x * neighbourhood_y, "min_valid_cells", "in [3, s_x*s_y]", min_valid_cells);
-	require(seed_search_radius > 0, "seed_search_radius", "> 0 m", seed_search_radius);
-	require(seed_height_tolerance > 0, "seed_height_tolerance", "> 0 m", seed_height_tolerance);
-	require(seed_attempts >= 1 && seed_attempts <= 100, "seed_attempts", "in [1, 100]", seed_attempts);
-	require(window_margin > 0, "window_margin", "> 0 m", window_margin);
-	require(min_nodes >= 3, "min_nodes", ">= 3", double(min_nodes));
-	require(ransac_iterations >= 1, "ransac_iterations", ">= 1", ransac_iterations);
-	require(ransac_inlier_distance > 0, "ransac_inlier_distance", "> 0 m", ransac_inlier_distance);
-	require(max_planes >= 1 && max_planes <= 8, "max_planes", "in [1, 8]", max_planes);
+	requireParams(neighbourhood_x % 2 == 1 && neighbourhood_y % 2 == 1, "", "s_x and s_y must be odd");
+	requireParams(
+		min_valid_cells <= neighbourhood_x * neighbourhood_y, "",
+		"min_valid_cells=" + std::to_string(min_valid_cells) + " is more than the s_x*s_y cells of a fit");
 }
 
 const char* GroundDetection::statusName(Status s)
@@ -156,7 +131,6 @@ bool RrtGroundDetector::findSeed(
 void RrtGroundDetector::detect(
 	const ElevationGrid& grid, const GroundSeedHint& hint, GroundDetection& out)
 {
-	m_params.validate();
 	out.clear();
 	if (grid.observedCount() == 0)
 	{

@@ -8,7 +8,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "gam/ElevationGrid.h"
+#include "gam/core/ElevationGrid.h"
+#include "gam/core/Parameters.h"
 
 namespace gam
 {
@@ -51,6 +52,19 @@ struct ProjectionFilter
 	float z_min = -std::numeric_limits<float>::infinity();
 	float z_max = std::numeric_limits<float>::infinity();
 	int decimation = 1;	 ///< use every n-th row and column
+
+	/** The .ini keys, shared by every map that projects depth frames. */
+	template <class Self, class Visit>
+	static void forEachParam(Self& p, Visit&& visit)
+	{
+		visit(ParamInfo{"z_min", -1e4, 1e4, "lowest z kept [m] (ground-aware grid: robot frame, floor = 0)"}, p.z_min);
+		visit(ParamInfo{"z_max", -1e4, 1e4, "highest z kept [m]"}, p.z_max);
+		visit(ParamInfo{"min_range", 0, 1e4, "closer sensor returns are dropped [m]"}, p.min_range);
+		visit(ParamInfo{"max_range", 0.01, 1e4, "farther sensor returns are dropped [m]"}, p.max_range);
+		visit(ParamInfo{"decimation", 1, 64, "use every n-th pixel row/column"}, p.decimation);
+	}
+	/** Ranges, z_min < z_max and min_range < max_range; throws std::invalid_argument. */
+	void validate() const;
 };
 
 /** Rigid transform sensor -> grid frame (row-major rotation and translation).
@@ -86,13 +100,8 @@ class DepthProjector
 		return {m_rayY[i], m_rayZ[i]};
 	}
 
-	/** The per-frame constants of the pixel loop (cell units in x and y). */
-	struct RowParams
-	{
-		float rx[3], ry[3], rz[3], t[3];
-		float min_range, max_range, z_min, z_max, nx, ny, units;
-		int32_t nx_cells;
-	};
+	/** Whether the AVX2 row loop can run here (CPU and build). */
+	static bool avx2Available();
 
    private:
 	void updateLut(const PinholeIntrinsics& K);
@@ -105,12 +114,5 @@ class DepthProjector
 	std::vector<float> m_rowZ;
 	bool m_allowAvx2 = true;
 };
-
-/** The row loop built for AVX2 (DepthProjectorAvx2.cpp) and whether this CPU
- * and build can run it. Internal to DepthProjector. */
-bool avx2RowLoopAvailable();
-void projectRowAvx2(
-	bool isDepth, const DepthProjector::RowParams& p, const uint16_t* row, const float* ky, const float* kz,
-	const float* invNorm, int cols, int32_t* cell, float* z);
 
 }  // namespace gam

@@ -10,6 +10,8 @@
 #include <limits>
 #include <vector>
 
+#include "gam/core/Parameters.h"
+
 namespace gam
 {
 /** Axis-aligned, regular 2D grid: cell (ix, iy) covers
@@ -152,6 +154,15 @@ struct OutlierFilterParams
 	 * std is ~0 (and float round-off can make it exactly 0), which would
 	 * otherwise reject good samples. 5 mm is below any depth camera's noise. */
 	float min_band = 0.005f;
+
+	/** The .ini keys, shared by every map that keeps a 2.5D grid. */
+	template <class Self, class Visit>
+	static void forEachParam(Self& p, Visit&& visit)
+	{
+		visit(ParamInfo{"outlier_filter", 0, 1, "3-sigma rule per cell and frame"}, p.enabled);
+		visit(ParamInfo{"outlier_sigmas", 0.5, 100, "k of the k-sigma rule"}, p.sigmas);
+		visit(ParamInfo{"outlier_min_count", 2, 1000000, "cells with fewer samples are not filtered"}, p.min_count);
+	}
 };
 
 /** Inverse distance weighting densification (fills empty cells). */
@@ -160,6 +171,15 @@ struct IdwParams
 	int radius_cells = 0;  ///< 0 disables it
 	float power = 2.0f;
 	int min_neighbours = 3;	 ///< observed cells needed in the window
+
+	/** The .ini keys, shared by every map that keeps a 2.5D grid. */
+	template <class Self, class Visit>
+	static void forEachParam(Self& p, Visit&& visit)
+	{
+		visit(ParamInfo{"idw_radius", 0, 50, "IDW window radius [cells], 0 = off"}, p.radius_cells);
+		visit(ParamInfo{"idw_power", 0.1, 10, "IDW distance exponent"}, p.power);
+		visit(ParamInfo{"idw_min_neighbours", 1, 10000, "observed cells needed to interpolate"}, p.min_neighbours);
+	}
 };
 
 class ElevationGrid

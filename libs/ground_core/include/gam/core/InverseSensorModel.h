@@ -10,8 +10,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "gam/ElevationGrid.h"
-#include "gam/RrtGroundDetector.h"
+#include "gam/core/ElevationGrid.h"
+#include "gam/core/Parameters.h"
+#include "gam/core/RrtGroundDetector.h"
 
 namespace gam
 {
@@ -46,8 +47,6 @@ struct IsmParams
 	/** Voxels whose bottom is more than this above the ground do not block
 	 * (ceiling, door frames, beams above the robot). [m] */
 	double robot_height = 1.8;
-	/** Voxels farther than this from the sensor (2D) are ignored. [m] */
-	double max_range = 5.0;
 	/** Below-ground voxels also mark the cells between the point where their
 	 * ray crossed the ground plane and the voxel: no floor was there. */
 	bool drop_rays = true;
@@ -61,6 +60,30 @@ struct IsmParams
 	/** How far from its nodes a ground patch applies. [m] */
 	double plane_support_radius = 0.4;
 
+	/** The .ini keys (paper Table I names), ranges and meanings (Parameters.h). */
+	template <class Self, class Visit>
+	static void forEachParam(Self& p, Visit&& visit)
+	{
+		visit(ParamInfo{"d_pth", 1e-6, 10, "plane distance threshold [m]"}, p.d_pth);
+		visit(ParamInfo{"K_g", 0, 0.499, "ground gain"}, p.K_g);
+		visit(ParamInfo{"sigma2", 1e-9, 100, "variance of the ground Gaussian [m^2]"}, p.sigma2);
+		visit(ParamInfo{"K_n", 1e-12, 1e6, "density gain [m^3/point]"}, p.K_n);
+		visit(ParamInfo{"d_min", -1e6, 1e6, "density sigmoid offset"}, p.d_min);
+		visit(ParamInfo{"K_m", 0, 0.999, "obstacle gain"}, p.K_m);
+		visit(ParamInfo{"depth_noise_c0", 0, 1, "sensor depth noise sigma = c0 + c2 r^2: c0 [m]"}, p.depth_noise_c0);
+		visit(ParamInfo{"depth_noise_c2", 0, 1, "c2 [1/m]"}, p.depth_noise_c2);
+		visit(ParamInfo{"noise_sigmas", 0, 10, "ground band = d_pth + noise_sigmas * vertical noise; 0 = fixed d_pth"}, p.noise_sigmas);
+		visit(ParamInfo{"min_obstacle_points", 1, 1000000, "obstacle/drop voxels with fewer samples are ignored (depth spikes)"}, p.min_obstacle_points);
+		visit(ParamInfo{"measure_floor_noise", 0, 1, "band from the floor's scatter measured in each frame (model where too little floor)"}, p.measure_floor_noise);
+		visit(ParamInfo{"floor_noise_min_cells", 1, 1000000, "floor cells a 0.5 m range bin needs to be measured"}, p.floor_noise_min_cells);
+		visit(ParamInfo{"robot_height", 1e-3, 100, "voxels entirely above this do not block [m]"}, p.robot_height);
+		visit(ParamInfo{"drop_rays", 0, 1, "mark cells where rays went below the ground"}, p.drop_rays);
+		visit(ParamInfo{"max_drop_ray_length", 0, 100, "longest drop ray [m]"}, p.max_drop_ray_length);
+		visit(ParamInfo{"drop_ray_min_points", 1, 1000000, "samples a drop voxel needs to cast its ray"}, p.drop_ray_min_points);
+		visit(ParamInfo{"local_planes", 0, 1, "use ramp patches near their nodes"}, p.local_planes);
+		visit(ParamInfo{"plane_support_radius", 0, 100, "reach of a ramp patch around its nodes [m]"}, p.plane_support_radius);
+	}
+	/** Throws std::invalid_argument naming the parameter out of range. */
 	void validate() const;
 };
 
@@ -105,15 +128,23 @@ struct IsmStats
 class InverseSensorModel
 {
    public:
-	explicit InverseSensorModel(const IsmParams& p = {}) : m_params(p) {}
-	void setParams(const IsmParams& p) { m_params = p; }
+	/** Throws std::invalid_argument for parameters out of range. */
+	explicit InverseSensorModel(const IsmParams& p = {}) { setParams(p); }
+	/** Validates (throws std::invalid_argument), then keeps `p`: compute()
+	 * runs with parameters checked once, not on every frame. */
+	void setParams(const IsmParams& p)
+	{
+		p.validate();
+		m_params = p;
+	}
 	const IsmParams& params() const { return m_params; }
 
 	/** Computes the evidence of one frame. `sensor` is the sensor position in
-	 * the grid frame. With no ground plane (det.ok() false) nothing is produced:
-	 * a frame without ground never invents obstacles. */
+	 * the grid frame; voxels farther than `maxRange` from it (2D) are ignored.
+	 * With no ground plane (det.ok() false) nothing is produced: a frame
+	 * without ground never invents obstacles. */
 	void compute(
-		const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor,
+		const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, double maxRange,
 		IsmStats& stats);
 
 	/** P(occupied) per frame cell; 0.5 where there is no evidence. */
@@ -146,6 +177,7 @@ class InverseSensorModel
 	std::vector<uint32_t> m_noiseBinStart;
 
 	IsmParams m_params;
+	double m_maxRange = 5.0;  ///< of the current compute() [m]
 	std::vector<float> m_evidence;
 	std::vector<uint32_t> m_evidenceCells;
 	std::vector<VoxelClass> m_class;

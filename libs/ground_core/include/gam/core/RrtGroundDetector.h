@@ -9,8 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "gam/ElevationGrid.h"
-#include "gam/PlaneFit.h"
+#include "gam/core/ElevationGrid.h"
+#include "gam/core/Parameters.h"
+#include "gam/core/PlaneFit.h"
 
 namespace gam
 {
@@ -54,6 +55,30 @@ struct RrtGpdParams
 	int max_planes = 3;
 	uint32_t random_seed = 1;
 
+	/** The .ini keys (paper Table I names), ranges and meanings (Parameters.h). */
+	template <class Self, class Visit>
+	static void forEachParam(Self& p, Visit&& visit)
+	{
+		visit(ParamInfo{"K", 1, 1000000, "RRT-GPD iterations"}, p.iterations);
+		visit(ParamInfo{"N_th", 1e-6, 1, "max horizontal part of a node's unit normal (sin of tilt)"}, p.normal_threshold);
+		visit(ParamInfo{"E_th", 1e-6, 10, "max height step from the parent's local plane [m]"}, p.elevation_threshold);
+		visit(ParamInfo{"s_x", 3, 31, "local fit neighbourhood along x [cells, odd]"}, p.neighbourhood_x);
+		visit(ParamInfo{"s_y", 3, 31, "local fit neighbourhood along y [cells, odd]"}, p.neighbourhood_y);
+		visit(ParamInfo{"d_n", 1e-3, 100, "node expansion distance [m]"}, p.expansion_distance);
+		visit(ParamInfo{"max_cell_std", 1e-6, 10, "cells rougher than this are not surfaces [m]"}, p.max_cell_std);
+		visit(ParamInfo{"max_fit_rms", 1e-6, 10, "local fits with a larger RMS are not planar [m]"}, p.max_fit_rms);
+		visit(ParamInfo{"min_valid_cells", 3, 961, "cells with a height a local fit needs"}, p.min_valid_cells);
+		visit(ParamInfo{"seed_search_radius", 1e-3, 1000, "seed within this distance of the robot [m]"}, p.seed_search_radius);
+		visit(ParamInfo{"seed_height_tolerance", 1e-3, 100, "seed height vs robot floor [m]"}, p.seed_height_tolerance);
+		visit(ParamInfo{"seed_attempts", 1, 100, "seeds tried when a tree stays too small"}, p.seed_attempts);
+		visit(ParamInfo{"window_margin", 1e-3, 1000, "sampling window margin around the nodes [m]"}, p.window_margin);
+		visit(ParamInfo{"min_nodes", 3, 1000000, "fewer tree nodes = no ground"}, p.min_nodes);
+		visit(ParamInfo{"ransac_iterations", 1, 1000000, "RANSAC iterations on the nodes"}, p.ransac_iterations);
+		visit(ParamInfo{"ransac_inlier_distance", 1e-6, 10, "RANSAC inlier distance [m]"}, p.ransac_inlier_distance);
+		visit(ParamInfo{"min_nodes_per_extra_plane", 0, 1000000, "nodes an extra ground patch (ramp) needs; 0 = none"}, p.min_nodes_per_extra_plane);
+		visit(ParamInfo{"max_planes", 1, 8, "ground plane + extra patches"}, p.max_planes);
+		visit(ParamInfo{"random_seed", 0, 2147483647, "RNG seed (same seed, same result)"}, p.random_seed);
+	}
 	/** Throws std::invalid_argument naming the parameter out of range. */
 	void validate() const;
 };
@@ -110,8 +135,15 @@ struct GroundSeedHint
 class RrtGroundDetector
 {
    public:
-	explicit RrtGroundDetector(const RrtGpdParams& p = {}) : m_params(p) {}
-	void setParams(const RrtGpdParams& p) { m_params = p; }
+	/** Throws std::invalid_argument for parameters out of range. */
+	explicit RrtGroundDetector(const RrtGpdParams& p = {}) { setParams(p); }
+	/** Validates (throws std::invalid_argument), then keeps `p`: detect() runs
+	 * with parameters checked once, not on every frame. */
+	void setParams(const RrtGpdParams& p)
+	{
+		p.validate();
+		m_params = p;
+	}
 	const RrtGpdParams& params() const { return m_params; }
 
 	/** Runs Algorithm 1 on `grid`. Deterministic for equal inputs and seed.

@@ -1,0 +1,123 @@
+// Ground-aware mapping for MRPT
+// The method of the paper in one place: a depth frame -> robot-centred 2.5D map
+// (projection, 3-sigma filter, IDW; §IV.A) -> RRT-GPD ground planes (§IV.B,
+// Alg. 1) -> inverse sensor model evidence per 2D cell (§IV.C). The pipeline
+// owns every stage, their scratch buffers and their timings; the MRPT map
+// (CGroundAwareOccupancyGrid) only adapts observations and fuses the evidence.
+// Pure code: no MRPT, no I/O. After the first frame of a given size it makes
+// no heap allocation.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "gam/core/DepthProjector.h"
+#include "gam/core/ElevationGrid.h"
+#include "gam/core/InverseSensorModel.h"
+#include "gam/core/Parameters.h"
+#include "gam/core/RrtGroundDetector.h"
+#include "gam/core/SensorFrame.h"
+
+namespace gam
+{
+/** Every parameter of the pipeline, nested per stage. Defaults: paper Table I
+ * where the paper has the value. */
+struct PipelineParams
+{
+	/** Cells of the robot-centred 2.5D map of one frame (its resolution d_r is
+	 * that of the caller's grid, see GridLattice). */
+	int m_x = 200, m_y = 200;
+	/** What is projected. z_min and z_max are in the robot frame (floor = 0);
+	 * points above ism.robot_height are dropped too (see projectionFilter()). */
+	ProjectionFilter projection = {0.0f, 5.0f, -3.0f, 2.5f, 1};
+	OutlierFilterParams outliers;  ///< 3-sigma rule
+	IdwParams idw = {1, 2.0f, 3};  ///< IDW, for the local plane fits only
+	RrtGpdParams rrt;
+	IsmParams ism;
+
+	template <class Self, class Visit>
+	static void forEachParam(Self& p, Visit&& visit)
+	{
+		visit(ParamInfo{"m_x", 3, 20000, "cells of the robot-centred 2.5D map along x"}, p.m_x);
+		visit(ParamInfo{"m_y", 3, 20000, "cells of the robot-centred 2.5D map along y"}, p.m_y);
+		ProjectionFilter::forEachParam(p.projection, visit);
+		OutlierFilterParams::forEachParam(p.outliers, visit);
+		IdwParams::forEachParam(p.idw, visit);
+		RrtGpdParams::forEachParam(p.rrt, visit);
+		IsmParams::forEachParam(p.ism, visit);
+	}
+	/** Every range and every rule between parameters; throws
+	 * std::invalid_argument naming the key. */
+	void validate() const;
+
+	/** The projector's filter for a robot standing at height `robotZ` (map
+	 * frame): the robot-frame z band, cropped at robot_height. */
+	ProjectionFilter projectionFilter(double robotZ) const;
+};
+
+/** The cells of the frame grid are aligned with this lattice: its corner
+ * (x0, y0) and its cell size (the caller's map grid). */
+struct GridLattice
+{
+	double x0 = 0, y0 = 0, resolution = 0.05;
+};
+
+/** Milliseconds each stage of the last frame took. */
+struct StageTimes
+{
+	double projection = 0;	///< frame grid placement + binning
+	double outliers = 0;  ///< 3-sigma filter + IDW
+	double ground = 0;	///< RRT-GPD + RANSAC
+	double ism = 0;	 ///< inverse sensor model
+};
+
+/** What the last frame gave. */
+struct FrameResult
+{
+	bool valid = false;	 ///< a frame was processed
+	size_t points = 0;	///< samples kept in the 2.5D map
+	Eigen::Vector3d sensor{0, 0, 0};  ///< sensor position (map frame)
+	GroundDetection detection;
+	IsmStats ism;
+	StageTimes ms;
+};
+
+class GroundAwarePipeline
+{
+   public:
+	/** Throws std::invalid_argument for parameters out of range. */
+	explicit GroundAwarePipeline(const PipelineParams& p = {});
+	/** Validates (throws std::invalid_argument, keeping the old parameters),
+	 * then applies `p`: frames run with parameters checked once. */
+	void setParams(const PipelineParams& p);
+	const PipelineParams& params() const { return m_params; }
+
+	/** Runs every stage on one frame taken by a robot at `robot` (map frame;
+	 * z = the floor under it). The frame grid is m_x x m_y cells of `lattice`,
+	 * centred on the robot. Throws std::invalid_argument for a non-finite
+	 * robot position, a bad lattice or a malformed frame. */
+	const FrameResult& process(const SensorFrame& frame, const Eigen::Vector3d& robot, const GridLattice& lattice);
+
+	/** Forgets the last frame (result().valid = false); buffers are kept. */
+	void resetResult();
+
+	const FrameResult& result() const { return m_result; }
+	/** The 2.5D map of the last frame. */
+	const ElevationGrid& frameGrid() const { return m_grid; }
+	/** Its evidence (P(occupied) per frame cell) and voxel classes. */
+	const InverseSensorModel& ism() const { return m_ism; }
+	/** The projector, e.g. to force the baseline row loop in tests. */
+	DepthProjector& projector() { return m_projector; }
+
+   private:
+	void placeGrid(const Eigen::Vector3d& robot, const GridLattice& lattice);
+
+	PipelineParams m_params;
+	DepthProjector m_projector;
+	ElevationGrid m_grid;
+	BinnedPoints m_bins;
+	RrtGroundDetector m_rrt;
+	InverseSensorModel m_ism;
+	FrameResult m_result;
+};
+
+}  // namespace gam

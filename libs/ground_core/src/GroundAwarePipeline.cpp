@@ -1,0 +1,123 @@
+#include "gam/core/GroundAwarePipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace gam
+{
+void PipelineParams::validate() const
+{
+	checkParamRanges(*this, "");
+	projection.validate();
+	rrt.validate();
+	{
+		// The per-frame 2.5D map: refuse what would not fit in memory before allocating it.
+		GridGeometry g;
+		g.nx = m_x;
+		g.ny = m_y;
+		try
+		{
+			g.validate();
+		}
+		catch (const std::invalid_argument& e)
+		{
+			throw std::invalid_argument(std::string("m_x x m_y: ") + e.what());
+		}
+	}
+}
+
+ProjectionFilter PipelineParams::projectionFilter(double robotZ) const
+{
+	ProjectionFilter f = projection;
+	f.z_min = float(robotZ + projection.z_min);
+	// Points above the robot can never block it; dropping them here keeps a
+	// beam or a door frame from merging with the floor below it into one tall
+	// 2.5D column (a cell keeps only z-min and z-max).
+	f.z_max = float(robotZ + std::min<double>(projection.z_max, ism.robot_height));
+	return f;
+}
+
+GroundAwarePipeline::GroundAwarePipeline(const PipelineParams& p) { setParams(p); }
+
+void GroundAwarePipeline::setParams(const PipelineParams& p)
+{
+	p.validate();
+	m_rrt.setParams(p.rrt);
+	m_ism.setParams(p.ism);
+	m_params = p;
+}
+
+void GroundAwarePipeline::resetResult()
+{
+	// As m_result = FrameResult{}, but the detection's vectors keep their
+	// capacity: no heap allocation per frame once they have grown.
+	m_result.valid = false;
+	m_result.points = 0;
+	m_result.sensor.setZero();
+	m_result.detection.clear();
+	m_result.ism = IsmStats{};
+	m_result.ms = StageTimes{};
+}
+
+void GroundAwarePipeline::placeGrid(const Eigen::Vector3d& robot, const GridLattice& lattice)
+{
+	// m_x x m_y cells centred on the robot, on the caller's cell lattice.
+	const double res = lattice.resolution;
+	GridGeometry g;
+	g.resolution = res;
+	g.nx = m_params.m_x;
+	g.ny = m_params.m_y;
+	g.x_min = lattice.x0 + std::round((robot.x() - 0.5 * m_params.m_x * res - lattice.x0) / res) * res;
+	g.y_min = lattice.y0 + std::round((robot.y() - 0.5 * m_params.m_y * res - lattice.y0) / res) * res;
+	const GridGeometry& cur = m_grid.geometry();
+	if (cur.nx != g.nx || cur.ny != g.ny || cur.resolution != g.resolution)
+		m_grid.resize(g);
+	else
+		m_grid.recenter(g.x_min, g.y_min);
+}
+
+const FrameResult& GroundAwarePipeline::process(
+	const SensorFrame& frame, const Eigen::Vector3d& robot, const GridLattice& lattice)
+{
+	using clk = std::chrono::steady_clock;
+	const auto ms = [](clk::time_point a, clk::time_point b) {
+		return std::chrono::duration<double, std::milli>(b - a).count();
+	};
+	if (!robot.allFinite()) throw std::invalid_argument("robot pose is not finite");
+	resetResult();
+	const auto t0 = clk::now();
+
+	// 1. The robot-centred 2.5D map of this frame.
+	placeGrid(robot, lattice);
+	m_bins.clear();
+	binSensorFrame(frame, m_params.projectionFilter(robot.z()), m_grid, m_projector, m_bins);
+	const auto t1 = clk::now();
+	m_result.points = m_grid.insert(m_bins, m_params.outliers);
+	if (m_params.idw.radius_cells > 0) m_grid.interpolateIdw(m_params.idw);
+	const auto t2 = clk::now();
+
+	// 2. Ground: RRT-GPD seeded under the robot.
+	GroundSeedHint hint;
+	hint.x = robot.x();
+	hint.y = robot.y();
+	hint.floor_z = robot.z();
+	m_rrt.detect(m_grid, hint, m_result.detection);
+	const auto t3 = clk::now();
+
+	// 3. Evidence.
+	m_result.sensor = frame.sensor_position;
+	m_ism.compute(m_grid, m_result.detection, m_result.sensor, m_params.projection.max_range, m_result.ism);
+	const auto t4 = clk::now();
+
+	m_result.valid = true;
+	m_result.ms.projection = ms(t0, t1);
+	m_result.ms.outliers = ms(t1, t2);
+	m_result.ms.ground = ms(t2, t3);
+	m_result.ms.ism = ms(t3, t4);
+	return m_result;
+}
+
+}  // namespace gam
