@@ -4,6 +4,7 @@
 #include <gam/mapper/Errors.h>
 #include <gam/mapper/Mapper.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
+#include <mrpt/maps/registerBaselineMaps.h>
 #include <mrpt/maps/registerGroundAwareMaps.h>
 
 #include <csignal>
@@ -40,7 +41,9 @@ int fail(int code, std::string msg)
 
 int main(int argc, char** argv)
 {
+	// The map plugins this program offers: the product and the comparison maps.
 	mrpt::maps::registerGroundAwareMaps();
+	mrpt::maps::registerBaselineMaps();
 	gam::mapper::MapperOptions o;
 	try
 	{

@@ -1,12 +1,16 @@
+#include <gam/maps/GridIO.h>
+#include <gam/maps/IniFields.h>
+#include <gam/maps/MapRegistry.h>
+#include <gam/maps/ObservationAdapters.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/img/color_maps.h>
 #include <mrpt/maps/CElevation25DMap.h>
-#include <mrpt/maps/gam_observation_adapters.h>
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/opengl/CSetOfTriangles.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -17,15 +21,41 @@ using namespace mrpt::maps;
 MAP_DEFINITION_REGISTER("mrpt::maps::CElevation25DMap,elevation25DMap", mrpt::maps::CElevation25DMap)
 IMPLEMENTS_SERIALIZABLE(CElevation25DMap, CMetricMap, mrpt::maps)
 
+namespace
+{
+// What tools need to know about this class (gam/maps/MapRegistry.h).
+const bool kTraitsRegistered = [] {
+	gam::maps::MapTraits t;
+	t.className = "mrpt::maps::CElevation25DMap";
+	t.sections = {
+		{"_creationOpts", gam::maps::gridCreationKeys()},
+		{"_insertOpts", gam::maps::ini::keys<CElevation25DMap::TInsertionOptions>()}};
+	t.writeOutputs = [](CMetricMap& m, const gam::maps::OutputContext& ctx, std::vector<std::string>& files) {
+		const auto& e = dynamic_cast<const CElevation25DMap&>(m);
+		const std::string base = ctx.dir + "/" + ctx.label;
+		e.saveAsPngs(base);
+		std::filesystem::copy_file(
+			base + "_zmax.png", base + ".png", std::filesystem::copy_options::overwrite_existing);
+		for (const char* ext : {".png", "_zmax.png", "_span.png", "_count.png", "_scale.txt"})
+			files.push_back(ctx.label + ext);
+		gam::maps::writeSerializedGz(e, base + ".map.gz");
+		files.push_back(ctx.label + ".map.gz");
+	};
+	gam::maps::registerMapTraits(std::move(t));
+	return true;
+}();
+}  // namespace
+
 CElevation25DMap::TMapDefinition::TMapDefinition() = default;
 
 void CElevation25DMap::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
 {
 	const std::string sC = sectionNamePrefix + "_creationOpts";
-	gam::ini::loadGridExtent(source, sC, min_x, max_x, min_y, max_y, resolution);
+	gam::maps::ini::loadGridExtent(source, sC, min_x, max_x, min_y, max_y, resolution);
 	// ElevationGrid has its own (smaller) cell limit: refuse before allocating.
-	gam::ini::loadThenCheck({}, source, sC, [&] {
+	try
+	{
 		gam::GridGeometry g;
 		g.x_min = min_x;
 		g.y_min = min_y;
@@ -33,7 +63,11 @@ void CElevation25DMap::TMapDefinition::loadFromConfigFile_map_specific(
 		g.nx = int(std::lround((max_x - min_x) / resolution));
 		g.ny = int(std::lround((max_y - min_y) / resolution));
 		g.validate();
-	});
+	}
+	catch (const std::invalid_argument& e)
+	{
+		throw std::invalid_argument(gam::maps::ini::sectionContext(sC) + " " + e.what());
+	}
 	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 }
 
@@ -48,75 +82,33 @@ mrpt::maps::CMetricMap* CElevation25DMap::internal_CreateFromMapDefinition(const
 {
 	const auto& def = dynamic_cast<const CElevation25DMap::TMapDefinition&>(_def);
 	auto* m = new CElevation25DMap(def.min_x, def.max_x, def.min_y, def.max_y, def.resolution);
-	m->insertionOptions = def.insertionOpts;
+	m->setInsertionOptions(def.insertionOpts);
 	return m;
 }
 
 // ---------------------------------------------------------------------------
-gam::ini::Fields CElevation25DMap::TInsertionOptions::fields()
-{
-	return {
-		{"z_min", &z_min, -1e4, 1e4, "points below this map-frame z are dropped [m]"},
-		{"z_max", &z_max, -1e4, 1e4, "points above this map-frame z are dropped [m]"},
-		{"min_range", &min_range, 0, 1e4, "closer returns are dropped [m]"},
-		{"max_range", &max_range, 0.01, 1e4, "farther returns are dropped [m]"},
-		{"decimation", &decimation, 1, 64, "use every n-th pixel row/column"},
-		{"outlier_filter", &outlier_filter, 0, 1, "3-sigma rule per cell and frame"},
-		{"outlier_sigmas", &outlier_sigmas, 0.5, 100, "k of the k-sigma rule"},
-		{"outlier_min_count", &outlier_min_count, 2, 1000000, "cells with fewer samples are not filtered"},
-		{"idw_radius", &idw_radius, 0, 50, "IDW window radius [cells], 0 = off"},
-		{"idw_power", &idw_power, 0.1, 10, "IDW distance exponent"},
-		{"idw_min_neighbours", &idw_min_neighbours, 1, 10000, "observed cells needed to interpolate"}};
-}
-
 void CElevation25DMap::TInsertionOptions::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& source, const std::string& section)
 {
-	gam::ini::loadThenCheck(fields(), source, section, [this] { validate(); });
+	gam::maps::ini::loadThenCheck(*this, source, section, [this] { validate(); });
 }
 
 void CElevation25DMap::TInsertionOptions::saveToConfigFile(
 	mrpt::config::CConfigFileBase& target, const std::string& section) const
 {
-	gam::ini::save(const_cast<TInsertionOptions*>(this)->fields(), target, section);
+	gam::maps::ini::save(*this, target, section);
 }
 
 void CElevation25DMap::TInsertionOptions::validate() const
 {
-	gam::ini::validate(const_cast<TInsertionOptions*>(this)->fields(), "CElevation25DMap insertOpts");
-	if (!(z_min < z_max))
-		throw std::invalid_argument("CElevation25DMap insertOpts: z_min must be < z_max");
-	if (!(min_range < max_range))
-		throw std::invalid_argument("CElevation25DMap insertOpts: min_range must be < max_range");
+	gam::checkParamRanges(*this, "");
+	projection.validate();
 }
 
-gam::OutlierFilterParams CElevation25DMap::TInsertionOptions::outlierParams() const
+void CElevation25DMap::setInsertionOptions(const TInsertionOptions& o)
 {
-	gam::OutlierFilterParams p;
-	p.enabled = outlier_filter;
-	p.sigmas = outlier_sigmas;
-	p.min_count = uint32_t(outlier_min_count);
-	return p;
-}
-
-gam::IdwParams CElevation25DMap::TInsertionOptions::idwParams() const
-{
-	gam::IdwParams p;
-	p.radius_cells = idw_radius;
-	p.power = idw_power;
-	p.min_neighbours = idw_min_neighbours;
-	return p;
-}
-
-gam::ProjectionFilter CElevation25DMap::TInsertionOptions::projectionFilter() const
-{
-	gam::ProjectionFilter f;
-	f.min_range = min_range;
-	f.max_range = max_range;
-	f.z_min = z_min;
-	f.z_max = z_max;
-	f.decimation = decimation;
-	return f;
+	o.validate();
+	m_options = o;
 }
 
 // ---------------------------------------------------------------------------
@@ -149,21 +141,19 @@ bool CElevation25DMap::isEmpty() const { return m_grid.observedCount() == 0; }
 
 void CElevation25DMap::finishInsertion()
 {
-	m_grid.insert(m_bins, insertionOptions.outlierParams());
+	m_grid.insert(m_bins, m_options.outliers);
 	m_bins.clear();
-	if (insertionOptions.idw_radius > 0) m_grid.interpolateIdw(insertionOptions.idwParams());
+	if (m_options.idw.radius_cells > 0) m_grid.interpolateIdw(m_options.idw);
 }
 
 bool CElevation25DMap::internal_insertObservation(
 	const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose)
 {
-	insertionOptions.validate();
-	gam::mrpt_glue::BinningOptions bo;
-	bo.filter = insertionOptions.projectionFilter();
 	m_bins.clear();
 	size_t n = 0;
-	if (!gam::mrpt_glue::binObservation(
-			obs, robotPose ? *robotPose : mrpt::poses::CPose3D(), bo, m_grid, m_projector, m_bins, &n))
+	if (!gam::maps::binObservation(
+			obs, robotPose ? *robotPose : mrpt::poses::CPose3D(), m_options.projection, m_grid, m_projector, m_bins,
+			&n))
 		return false;
 	finishInsertion();
 	return n > 0;
@@ -171,12 +161,11 @@ bool CElevation25DMap::internal_insertObservation(
 
 size_t CElevation25DMap::insertPointCloud(const mrpt::maps::CPointsMap& pts, const mrpt::poses::CPose3D& pose)
 {
-	insertionOptions.validate();
 	m_bins.clear();
-	gam::ProjectionFilter f = insertionOptions.projectionFilter();
+	gam::ProjectionFilter f = m_options.projection;
 	f.min_range = 0;  // ranges mean nothing for an already registered cloud
 	f.max_range = std::numeric_limits<float>::max();
-	gam::mrpt_glue::binPointCloud(pts, pose, f, m_grid, m_bins);
+	gam::maps::binPointCloud(pts, pose, f, m_grid, m_bins);
 	const size_t n = m_bins.size();
 	finishInsertion();
 	return n;
@@ -213,10 +202,10 @@ void CElevation25DMap::serializeTo(mrpt::serialization::CArchive& out) const
 {
 	const auto& g = m_grid.geometry();
 	out << g.x_min << g.y_min << g.resolution << int32_t(g.nx) << int32_t(g.ny);
-	const auto& o = insertionOptions;
-	out << o.z_min << o.z_max << o.min_range << o.max_range << int32_t(o.decimation)
-		<< o.outlier_filter << o.outlier_sigmas << int32_t(o.outlier_min_count)
-		<< int32_t(o.idw_radius) << o.idw_power << int32_t(o.idw_min_neighbours);
+	const auto& o = m_options;
+	out << o.projection.z_min << o.projection.z_max << o.projection.min_range << o.projection.max_range
+		<< int32_t(o.projection.decimation) << o.outliers.enabled << o.outliers.sigmas << int32_t(o.outliers.min_count)
+		<< int32_t(o.idw.radius_cells) << o.idw.power << int32_t(o.idw.min_neighbours);
 	out << genericMapParams;
 	out << uint32_t(m_grid.observedCount());
 	for (uint32_t i : m_grid.observedCells())
@@ -238,14 +227,15 @@ void CElevation25DMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t 
 			g.nx = nx;
 			g.ny = ny;
 			m_grid.resize(g);  // validates
-			auto& o = insertionOptions;
+			TInsertionOptions o;
 			int32_t dec, omc, idr, idn;
-			in >> o.z_min >> o.z_max >> o.min_range >> o.max_range >> dec >> o.outlier_filter >>
-				o.outlier_sigmas >> omc >> idr >> o.idw_power >> idn;
-			o.decimation = dec;
-			o.outlier_min_count = omc;
-			o.idw_radius = idr;
-			o.idw_min_neighbours = idn;
+			in >> o.projection.z_min >> o.projection.z_max >> o.projection.min_range >> o.projection.max_range >> dec >>
+				o.outliers.enabled >> o.outliers.sigmas >> omc >> idr >> o.idw.power >> idn;
+			o.projection.decimation = dec;
+			o.outliers.min_count = uint32_t(omc);
+			o.idw.radius_cells = idr;
+			o.idw.min_neighbours = idn;
+			setInsertionOptions(o);	 // validates
 			in >> genericMapParams;
 			uint32_t n;
 			in >> n;
@@ -261,7 +251,7 @@ void CElevation25DMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t 
 					throw std::runtime_error("CElevation25DMap: corrupt stream (bad cell)");
 				m_grid.restoreCell(i, c);
 			}
-			if (o.idw_radius > 0) m_grid.interpolateIdw(o.idwParams());
+			if (o.idw.radius_cells > 0) m_grid.interpolateIdw(o.idw);
 		}
 		break;
 		default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);

@@ -1,8 +1,6 @@
 #include <mrpt/core/initializer.h>
 #include <mrpt/maps/CElevation25DMap.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
-#include <mrpt/maps/CHeightBandOccupancyGrid.h>
-#include <mrpt/maps/COctoMapGrid2D.h>
 #include <mrpt/maps/registerGroundAwareMaps.h>
 #include <mrpt/rtti/CObject.h>
 
@@ -27,6 +25,4 @@ void mrpt::maps::registerGroundAwareMaps()
 	// Idempotent: registerClass ignores classes it already knows.
 	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CElevation25DMap));
 	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CGroundAwareOccupancyGrid));
-	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CHeightBandOccupancyGrid));
-	mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::COctoMapGrid2D));
 }

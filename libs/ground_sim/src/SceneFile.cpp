@@ -1,6 +1,7 @@
 // Ground-aware mapping for MRPT -- scene simulator: scene text parser (format in SceneFile.h).
 #include "gam/sim/SceneFile.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -13,10 +14,13 @@ namespace
 {
 constexpr double kDeg = M_PI / 180.0;
 
+/** The key=value arguments of one statement; every error names the file, line and
+ * keyword. */
 class Args
 {
    public:
 	Args(const std::string& kw, const std::string& where) : m_kw(kw), m_where(where) {}
+	const std::string& keyword() const { return m_kw; }
 	[[noreturn]] void fail(const std::string& msg) const
 	{
 		throw SceneError(m_where + ": " + m_kw + ": " + msg);
@@ -80,11 +84,17 @@ class Args
 			if (req) fail("missing " + k + "=");
 			return {};
 		}
+		const std::vector<double> v = numbers(k, str(k));
+		if (v.size() != n) fail(k + " needs " + std::to_string(n) + " comma-separated numbers");
+		return v;
+	}
+	/** The comma-separated numbers of `text`, a value of key `k` (named in the errors). */
+	std::vector<double> numbers(const std::string& k, const std::string& text) const
+	{
 		std::vector<double> v;
-		std::stringstream ss(str(k));
+		std::stringstream ss(text);
 		std::string item;
 		while (std::getline(ss, item, ',')) v.push_back(toNum(k, item));
-		if (v.size() != n) fail(k + " needs " + std::to_string(n) + " comma-separated numbers");
 		return v;
 	}
 	void finish() const
@@ -117,14 +127,379 @@ ConvexSolid localBox(const Pose3& f, const Eigen::Vector3d& lo, const Eigen::Vec
 	c.t = f.apply(0.5 * (lo + hi));
 	return ConvexSolid::box(c, 0.5 * (hi - lo), id);
 }
+
+/** What the statements build, line after line. */
+struct SceneBuilder
+{
+	SceneFile sf;
+	std::set<int> ids;  ///< object ids used so far
+	bool havePath = false;
+};
+
+/** The keys every object takes (id=, name=, category=); adds the object to the scene. */
+ObjectInfo& beginObject(SceneBuilder& b, Args& a, const std::string& type)
+{
+	const double idd = a.req("id");
+	if (idd < 1 || idd != std::floor(idd) || idd > 1e9) a.fail("id must be an integer >= 1");
+	const int id = int(idd);
+	if (b.ids.count(id)) a.fail("duplicate id " + std::to_string(id));
+	b.ids.insert(id);
+	ObjectInfo oi;
+	oi.id = id;
+	oi.type = type;
+	oi.name = a.str("name", type + "_" + std::to_string(id));
+	if (a.has("category"))
+	{
+		if (!categoryFromName(a.str("category"), oi.category))
+			a.fail("unknown category '" + a.str("category") + "'");
+		oi.category_given = true;
+	}
+	b.sf.scene.objects.push_back(oi);
+	return b.sf.scene.objects.back();
+}
+
+/** Bounding box of the last object: the solids and holes from index firstSolid and
+ * firstHole on (those its statement added). */
+void finishObject(Scene& sc, size_t firstSolid, size_t firstHole)
+{
+	ObjectInfo* oi = &sc.objects.back();
+	oi->bbox.setEmpty();
+	for (size_t i = firstSolid; i < sc.solids.size(); i++) oi->bbox.extend(sc.solids[i].bbox);
+	for (size_t i = firstHole; i < sc.holes.size(); i++)
+	{
+		const Hole& h = sc.holes[i];
+		const double r = h.shape == Hole::Circle ? h.r : std::hypot(h.hx, h.hy);
+		const double c = std::cos(h.yaw), s = std::sin(h.yaw);
+		const double ex = h.shape == Hole::Circle ? r : std::abs(c * h.hx) + std::abs(s * h.hy);
+		const double ey = h.shape == Hole::Circle ? r : std::abs(s * h.hx) + std::abs(c * h.hy);
+		const double zb = std::isfinite(h.depth) ? -h.depth : -1e3;
+		oi->bbox.extend(Eigen::Vector3d(h.cx - ex, h.cy - ey, zb));
+		oi->bbox.extend(Eigen::Vector3d(h.cx + ex, h.cy + ey, 0));
+	}
+}
+
+// One handler per statement: each reads its own arguments (and their defaults) from
+// `a` into the scene; the keys it does not read are reported by Args::finish().
+
+void parseFloor(SceneBuilder& b, Args& a) { b.sf.scene.has_floor = a.num("present", 1) != 0; }
+
+void parseKinect(SceneBuilder& b, Args& a)
+{
+	SceneFile& sf = b.sf;
+	sf.kinect_pose = poseOf(a.list("pose", 6));
+	auto& k = sf.kinect;
+	k.noise_scale = a.num("noise_scale", k.noise_scale);
+	if (k.noise_scale < 0) a.fail("noise_scale must be >= 0");
+	k.min_range = a.pos("min_range", k.min_range);
+	k.max_range = a.pos("max_range", k.max_range);
+	if (k.max_range <= k.min_range) a.fail("max_range must be > min_range");
+	k.spike_prob = a.num("spike_prob", k.spike_prob);
+	k.flying_prob = a.num("flying_prob", k.flying_prob);
+	if (k.spike_prob < 0 || k.spike_prob > 1 || k.flying_prob < 0 || k.flying_prob > 1)
+		a.fail("probabilities must be in [0,1]");
+	k.grazing_start_deg = a.num("grazing_start", k.grazing_start_deg);
+	k.grazing_end_deg = a.num("grazing_end", k.grazing_end_deg);
+	if (!(k.grazing_end_deg > k.grazing_start_deg)) a.fail("grazing_end must be > grazing_start");
+	sf.kinect_sway = a.num("sway", 0) * kDeg;
+	if (sf.kinect_sway < 0 || sf.kinect_sway > 10 * kDeg) a.fail("sway must be in [0,10] degrees");
+}
+
+void parseLeddar(SceneBuilder& b, Args& a)
+{
+	SceneFile& sf = b.sf;
+	sf.leddar_pose = poseOf(a.list("pose", 6));
+	sf.leddar_enabled = a.num("enabled", 1) != 0;
+	sf.leddar.sigma = a.num("sigma", sf.leddar.sigma);
+	if (sf.leddar.sigma < 0) a.fail("sigma must be >= 0");
+	sf.leddar.max_range = a.pos("max_range", sf.leddar.max_range);
+	sf.leddar.vfov_deg = a.pos("vfov", sf.leddar.vfov_deg);
+}
+
+void parseHole(SceneBuilder& b, Args& a)
+{
+	ObjectInfo& oi = beginObject(b, a, "hole");
+	Hole h;
+	h.object_id = oi.id;
+	const std::string shape = a.str("shape", "rect");
+	h.cx = a.req("x");
+	h.cy = a.req("y");
+	h.depth = a.pos("depth", 0, true);
+	if (shape == "rect")
+	{
+		h.shape = Hole::Rect;
+		h.hx = 0.5 * a.pos("sx", 0, true);
+		h.hy = 0.5 * a.pos("sy", 0, true);
+		h.yaw = a.num("yaw", 0) * kDeg;
+	}
+	else if (shape == "circle")
+	{
+		h.shape = Hole::Circle;
+		h.r = a.pos("r", 0, true);
+	}
+	else
+		a.fail("shape must be rect or circle");
+	b.sf.scene.holes.push_back(h);
+}
+
+void parseBox(SceneBuilder& b, Args& a)
+{
+	ObjectInfo& oi = beginObject(b, a, "box");
+	const double x = a.req("x"), y = a.req("y"), z = a.num("z", 0);
+	const Eigen::Vector3d h(0.5 * a.pos("sx", 0, true), 0.5 * a.pos("sy", 0, true), 0.5 * a.pos("sz", 0, true));
+	const double yaw = a.num("yaw", 0) * kDeg, pitch = a.num("pitch", 0) * kDeg, roll = a.num("roll", 0) * kDeg;
+	// (x,y,z) = centre of the bottom face before pitch/roll
+	Pose3 base = Pose3::fromXYZYPR(x, y, z, yaw, pitch, roll);
+	Pose3 c = base;
+	c.t = base.apply(Eigen::Vector3d(0, 0, h.z()));
+	b.sf.scene.solids.push_back(ConvexSolid::box(c, h, oi.id));
+}
+
+void parseWall(SceneBuilder& b, Args& a)
+{
+	ObjectInfo& oi = beginObject(b, a, "wall");
+	const double x0 = a.req("x0"), y0 = a.req("y0"), x1 = a.req("x1"), y1 = a.req("y1");
+	const double th = a.pos("thickness", 0.10), hgt = a.pos("height", 2.5);
+	const double len = std::hypot(x1 - x0, y1 - y0);
+	if (len <= 0) a.fail("zero-length wall");
+	const double yaw = std::atan2(y1 - y0, x1 - x0);
+	Pose3 c = Pose3::fromXYZYPR(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * hgt, yaw, 0, 0);
+	b.sf.scene.solids.push_back(ConvexSolid::box(c, Eigen::Vector3d(0.5 * len, 0.5 * th, 0.5 * hgt), oi.id));
+}
+
+/** The arguments stairs_down and stairs_up share (x= y= yaw= width= rise= run= steps=). */
+struct Stairs
+{
+	int id = 0;
+	double yaw = 0, w = 0, rise = 0, run = 0;
+	int steps = 0;
+	Pose3 f;  ///< local frame: x along the stairs, origin at (x,y) on the floor
+};
+
+Stairs beginStairs(SceneBuilder& b, Args& a)
+{
+	Stairs s;
+	s.id = beginObject(b, a, a.keyword()).id;
+	const double x = a.req("x"), y = a.req("y"), yaw = a.num("yaw", 0);
+	const double w = a.pos("width", 0, true), rise = a.pos("rise", 0, true), run = a.pos("run", 0, true);
+	const double stepsD = a.req("steps");
+	if (stepsD < 1 || stepsD != std::floor(stepsD) || stepsD > 100) a.fail("steps must be an integer in 1..100");
+	s.yaw = yaw;
+	s.w = w;
+	s.rise = rise;
+	s.run = run;
+	s.steps = int(stepsD);
+	s.f = planar(x, y, 0, yaw);
+	return s;
+}
+
+void parseStairsDown(SceneBuilder& b, Args& a)
+{
+	const Stairs s = beginStairs(b, a);
+	const double landing = a.pos("landing", 1.0);
+	const double L = s.steps * s.run + landing, D = s.steps * s.rise;
+	Hole h;
+	h.shape = Hole::Rect;
+	const Eigen::Vector3d c = s.f.apply(Eigen::Vector3d(0.5 * L, 0, 0));
+	h.cx = c.x();
+	h.cy = c.y();
+	h.hx = 0.5 * L;
+	h.hy = 0.5 * s.w;
+	h.yaw = s.yaw * kDeg;
+	h.depth = D;
+	h.object_id = s.id;
+	b.sf.scene.holes.push_back(h);
+	// tread k (1..steps-1) at z = -k*rise over x in [(k-1)run, k run]
+	for (int k = 1; k < s.steps; k++)
+		b.sf.scene.solids.push_back(localBox(
+			s.f, Eigen::Vector3d((k - 1) * s.run, -0.5 * s.w, -D),
+			Eigen::Vector3d(k * s.run, 0.5 * s.w, -k * s.rise), s.id));
+}
+
+void parseStairsUp(SceneBuilder& b, Args& a)
+{
+	const Stairs s = beginStairs(b, a);
+	const double top = a.pos("top", 1.0);
+	const double L = s.steps * s.run + top;
+	for (int k = 1; k <= s.steps; k++)
+		b.sf.scene.solids.push_back(localBox(
+			s.f, Eigen::Vector3d((k - 1) * s.run, -0.5 * s.w, 0), Eigen::Vector3d(L, 0.5 * s.w, k * s.rise), s.id));
+}
+
+void parseRamp(SceneBuilder& b, Args& a)
+{
+	Scene& sc = b.sf.scene;
+	ObjectInfo& oi = beginObject(b, a, "ramp");
+	const double x = a.req("x"), y = a.req("y"), yaw = a.num("yaw", 0);
+	const double L = a.pos("length", 0, true), w = a.pos("width", 0, true);
+	const double ang = a.pos("angle", 0, true);
+	if (ang >= 60) a.fail("angle must be < 60 degrees");
+	oi.slope_deg = ang;
+	const std::string sides = a.str("sides", "solid");
+	const double th = a.pos("thickness", 0.03);
+	const double plateau = a.num("plateau", 0);
+	const bool back = a.num("back", 0) != 0;
+	if (plateau < 0) a.fail("plateau must be >= 0");
+	const double H = L * std::tan(ang * kDeg);
+	const Pose3 f = planar(x, y, 0, yaw);
+	auto addSlope = [&](const Pose3& fr) {
+		if (sides == "solid")
+			sc.solids.push_back(ConvexSolid::wedge(fr, L, w, ang * kDeg, oi.id));
+		else if (sides == "open")
+		{
+			// tilted plate: its top surface is the ramp surface
+			const double hyp = L / std::cos(ang * kDeg);
+			Pose3 tilt = fr * Pose3::fromXYZYPR(0, 0, 0, 0, -ang * kDeg, 0);
+			Pose3 c = tilt;
+			c.t = tilt.apply(Eigen::Vector3d(0.5 * hyp, 0, -0.5 * th));
+			sc.solids.push_back(ConvexSolid::box(c, Eigen::Vector3d(0.5 * hyp, 0.5 * w, 0.5 * th), oi.id));
+		}
+		else
+			a.fail("sides must be solid or open");
+	};
+	addSlope(f);
+	if (plateau > 0)
+		sc.solids.push_back(localBox(
+			f, Eigen::Vector3d(L, -0.5 * w, sides == "solid" ? 0.0 : H - th),
+			Eigen::Vector3d(L + plateau, 0.5 * w, H), oi.id));
+	if (back) addSlope(f * planar(2 * L + plateau, 0, 0, 180.0));
+}
+
+void parseTable(SceneBuilder& b, Args& a)
+{
+	Scene& sc = b.sf.scene;
+	ObjectInfo& oi = beginObject(b, a, "table");
+	const Pose3 f = planar(a.req("x"), a.req("y"), 0, a.num("yaw", 0));
+	const double sx = a.pos("sx", 0, true), sy = a.pos("sy", 0, true);
+	const double H = a.pos("height", 0.75), top = a.pos("top", 0.04), leg = a.pos("leg", 0.05);
+	if (top >= H || 2 * leg >= std::min(sx, sy)) a.fail("inconsistent table sizes");
+	sc.solids.push_back(localBox(
+		f, Eigen::Vector3d(-0.5 * sx, -0.5 * sy, H - top), Eigen::Vector3d(0.5 * sx, 0.5 * sy, H), oi.id));
+	for (int i = 0; i < 4; i++)
+	{
+		const double lx = (i & 1) ? 0.5 * sx - leg : -0.5 * sx;
+		const double ly = (i & 2) ? 0.5 * sy - leg : -0.5 * sy;
+		sc.solids.push_back(localBox(
+			f, Eigen::Vector3d(lx, ly, 0), Eigen::Vector3d(lx + leg, ly + leg, H - top), oi.id));
+	}
+}
+
+void parseShelf(SceneBuilder& b, Args& a)
+{
+	Scene& sc = b.sf.scene;
+	ObjectInfo& oi = beginObject(b, a, "shelf");
+	const Pose3 f = planar(a.req("x"), a.req("y"), 0, a.num("yaw", 0));
+	const double sx = a.pos("sx", 0, true), sy = a.pos("sy", 0, true), sz = a.pos("sz", 0, true);
+	const double nb = a.num("boards", 4), bt = a.pos("board", 0.02), side = a.pos("side", 0.02);
+	const double bottom = a.num("bottom", 0.10);
+	if (nb < 1 || nb != std::floor(nb) || nb > 50) a.fail("boards must be an integer in 1..50");
+	if (bottom < 0 || bottom + bt > sz || 2 * side >= sx) a.fail("inconsistent shelf sizes");
+	// sides at local x = +-sx/2 (the shelf's length runs along local x)
+	for (int s = -1; s <= 1; s += 2)
+	{
+		const double x0 = s < 0 ? -0.5 * sx : 0.5 * sx - side;
+		sc.solids.push_back(localBox(
+			f, Eigen::Vector3d(x0, -0.5 * sy, 0), Eigen::Vector3d(x0 + side, 0.5 * sy, sz), oi.id));
+	}
+	const int n = int(nb);
+	for (int k = 0; k < n; k++)
+	{
+		const double z = n == 1 ? bottom : bottom + k * (sz - bt - bottom) / (n - 1);
+		sc.solids.push_back(localBox(
+			f, Eigen::Vector3d(-0.5 * sx + side, -0.5 * sy, z), Eigen::Vector3d(0.5 * sx - side, 0.5 * sy, z + bt),
+			oi.id));
+	}
+}
+
+void parsePath(SceneBuilder& b, Args& a)
+{
+	if (b.havePath) a.fail("only one path allowed");
+	b.havePath = true;
+	PathSpec& p = b.sf.path;
+	std::stringstream ws(a.str("waypoints", "", true));
+	std::string wp;
+	while (std::getline(ws, wp, ';'))
+	{
+		const std::vector<double> v = a.numbers("waypoints", wp);
+		if (v.size() != 3) a.fail("each waypoint needs x,y,yaw (got '" + wp + "')");
+		p.waypoints.push_back({v[0], v[1], v[2] * kDeg});
+	}
+	if (p.waypoints.empty()) a.fail("no waypoints");
+	p.spacing = a.pos("spacing", p.spacing);
+	p.turn_spacing = a.pos("turn_spacing", p.turn_spacing / kDeg) * kDeg;
+	const double fr = a.num("frames", 0);
+	if (fr < 0 || fr != std::floor(fr) || fr > 1e6) a.fail("frames must be an integer >= 0");
+	p.frames = int(fr);
+	p.rate_hz = a.pos("rate", p.rate_hz);
+}
+
+void parseOdometryNoise(SceneBuilder& b, Args& a)
+{
+	auto& o = b.sf.odometry_noise;
+	o.xy_per_m = a.num("xy", 0);
+	o.yaw_per_m = a.num("yaw", 0) * kDeg;
+	o.yaw_per_rad = a.num("turn", 0);
+	if (o.xy_per_m < 0 || o.yaw_per_m < 0 || o.yaw_per_rad < 0) a.fail("noise must be >= 0");
+}
+
+void parseGrid(SceneBuilder& b, Args& a)
+{
+	GridSpec& g = b.sf.grid;
+	g.resolution = a.pos("resolution", g.resolution);
+	g.min_x = a.req("min_x");
+	g.max_x = a.req("max_x");
+	g.min_y = a.req("min_y");
+	g.max_y = a.req("max_y");
+	if (g.max_x <= g.min_x || g.max_y <= g.min_y) a.fail("empty grid extent");
+	if ((g.max_x - g.min_x) / g.resolution * (g.max_y - g.min_y) / g.resolution > 5e7) a.fail("grid too large");
+	g.robot_height = a.pos("robot_height", g.robot_height);
+	g.obstacle_min_height = a.pos("obstacle_min", g.obstacle_min_height);
+	g.drop_min_depth = a.pos("drop_min", g.drop_min_depth);
+	g.small_max_height = a.pos("small_max", g.small_max_height);
+	g.overhang_clearance = a.pos("overhang_clearance", g.overhang_clearance);
+	g.max_slope_deg = a.pos("max_slope", g.max_slope_deg);
+	const double ss = a.num("subsamples", g.subsamples);
+	if (ss < 1 || ss > 9 || ss != std::floor(ss)) a.fail("subsamples must be an integer in 1..9");
+	g.subsamples = int(ss);
+	b.sf.has_grid = true;
+}
+
+/** A scene file is one statement per line: a keyword and its key=value arguments
+ * ('#' starts a comment; the format is in SceneFile.h, examples in config/scenes/).
+ * This table gives the handler of each keyword. */
+struct Statement
+{
+	const char* keyword;
+	void (*parse)(SceneBuilder& b, Args& a);
+};
+constexpr Statement kStatements[] = {
+	{"floor", parseFloor},
+	{"kinect", parseKinect},
+	{"leddar", parseLeddar},
+	{"hole", parseHole},
+	{"box", parseBox},
+	{"wall", parseWall},
+	{"stairs_down", parseStairsDown},
+	{"stairs_up", parseStairsUp},
+	{"ramp", parseRamp},
+	{"table", parseTable},
+	{"shelf", parseShelf},
+	{"path", parsePath},
+	{"odometry_noise", parseOdometryNoise},
+	{"grid", parseGrid},
+};
+
+const Statement* findStatement(const std::string& kw)
+{
+	for (const Statement& s : kStatements)
+		if (kw == s.keyword) return &s;
+	return nullptr;
+}
 }  // namespace
 
 SceneFile parseScene(std::istream& in, const std::string& filename)
 {
-	SceneFile sf;
-	Scene& sc = sf.scene;
-	std::set<int> ids;
-	bool havePath = false;
+	SceneBuilder b;
+	Scene& sc = b.sf.scene;
 	std::string line;
 	int lineNo = 0;
 	while (std::getline(in, line))
@@ -139,323 +514,30 @@ SceneFile parseScene(std::istream& in, const std::string& filename)
 		Args a(kw, where);
 		while (ss >> tok) a.add(tok);
 
-		// common object keys
-		auto beginObject = [&](const std::string& type) -> ObjectInfo& {
-			const double idd = a.req("id");
-			if (idd < 1 || idd != std::floor(idd) || idd > 1e9) a.fail("id must be an integer >= 1");
-			const int id = int(idd);
-			if (ids.count(id)) a.fail("duplicate id " + std::to_string(id));
-			ids.insert(id);
-			ObjectInfo oi;
-			oi.id = id;
-			oi.type = type;
-			oi.name = a.str("name", type + "_" + std::to_string(id));
-			if (a.has("category"))
-			{
-				if (!categoryFromName(a.str("category"), oi.category))
-					a.fail("unknown category '" + a.str("category") + "'");
-				oi.category_given = true;
-			}
-			sc.objects.push_back(oi);
-			return sc.objects.back();
-		};
-		auto finishObject = [&](int id, size_t firstSolid, size_t firstHole) {
-			ObjectInfo* oi = nullptr;
-			for (auto& o : sc.objects)
-				if (o.id == id) oi = &o;
-			oi->bbox.setEmpty();
-			for (size_t i = firstSolid; i < sc.solids.size(); i++) oi->bbox.extend(sc.solids[i].bbox);
-			for (size_t i = firstHole; i < sc.holes.size(); i++)
-			{
-				const Hole& h = sc.holes[i];
-				const double r = h.shape == Hole::Circle ? h.r : std::hypot(h.hx, h.hy);
-				const double c = std::cos(h.yaw), s = std::sin(h.yaw);
-				const double ex = h.shape == Hole::Circle ? r : std::abs(c * h.hx) + std::abs(s * h.hy);
-				const double ey = h.shape == Hole::Circle ? r : std::abs(s * h.hx) + std::abs(c * h.hy);
-				const double zb = std::isfinite(h.depth) ? -h.depth : -1e3;
-				oi->bbox.extend(Eigen::Vector3d(h.cx - ex, h.cy - ey, zb));
-				oi->bbox.extend(Eigen::Vector3d(h.cx + ex, h.cy + ey, 0));
-			}
-		};
+		const Statement* st = findStatement(kw);
+		if (!st) throw SceneError(where + ": unknown statement '" + kw + "'");
 		const size_t s0 = sc.solids.size(), h0 = sc.holes.size();
-
-		if (kw == "floor")
-		{
-			sc.has_floor = a.num("present", 1) != 0;
-		}
-		else if (kw == "kinect")
-		{
-			sf.kinect_pose = poseOf(a.list("pose", 6));
-			auto& k = sf.kinect;
-			k.noise_scale = a.num("noise_scale", k.noise_scale);
-			if (k.noise_scale < 0) a.fail("noise_scale must be >= 0");
-			k.min_range = a.pos("min_range", k.min_range);
-			k.max_range = a.pos("max_range", k.max_range);
-			if (k.max_range <= k.min_range) a.fail("max_range must be > min_range");
-			k.spike_prob = a.num("spike_prob", k.spike_prob);
-			k.flying_prob = a.num("flying_prob", k.flying_prob);
-			if (k.spike_prob < 0 || k.spike_prob > 1 || k.flying_prob < 0 || k.flying_prob > 1)
-				a.fail("probabilities must be in [0,1]");
-			k.grazing_start_deg = a.num("grazing_start", k.grazing_start_deg);
-			k.grazing_end_deg = a.num("grazing_end", k.grazing_end_deg);
-			if (!(k.grazing_end_deg > k.grazing_start_deg)) a.fail("grazing_end must be > grazing_start");
-			sf.kinect_sway = a.num("sway", 0) * kDeg;
-			if (sf.kinect_sway < 0 || sf.kinect_sway > 10 * kDeg) a.fail("sway must be in [0,10] degrees");
-		}
-		else if (kw == "leddar")
-		{
-			sf.leddar_pose = poseOf(a.list("pose", 6));
-			sf.leddar_enabled = a.num("enabled", 1) != 0;
-			sf.leddar.sigma = a.num("sigma", sf.leddar.sigma);
-			if (sf.leddar.sigma < 0) a.fail("sigma must be >= 0");
-			sf.leddar.max_range = a.pos("max_range", sf.leddar.max_range);
-			sf.leddar.vfov_deg = a.pos("vfov", sf.leddar.vfov_deg);
-		}
-		else if (kw == "hole")
-		{
-			ObjectInfo& oi = beginObject("hole");
-			Hole h;
-			h.object_id = oi.id;
-			const std::string shape = a.str("shape", "rect");
-			h.cx = a.req("x");
-			h.cy = a.req("y");
-			h.depth = a.pos("depth", 0, true);
-			if (shape == "rect")
-			{
-				h.shape = Hole::Rect;
-				h.hx = 0.5 * a.pos("sx", 0, true);
-				h.hy = 0.5 * a.pos("sy", 0, true);
-				h.yaw = a.num("yaw", 0) * kDeg;
-			}
-			else if (shape == "circle")
-			{
-				h.shape = Hole::Circle;
-				h.r = a.pos("r", 0, true);
-			}
-			else
-				a.fail("shape must be rect or circle");
-			sc.holes.push_back(h);
-		}
-		else if (kw == "box")
-		{
-			ObjectInfo& oi = beginObject("box");
-			const double x = a.req("x"), y = a.req("y"), z = a.num("z", 0);
-			const Eigen::Vector3d h(0.5 * a.pos("sx", 0, true), 0.5 * a.pos("sy", 0, true), 0.5 * a.pos("sz", 0, true));
-			const double yaw = a.num("yaw", 0) * kDeg, pitch = a.num("pitch", 0) * kDeg, roll = a.num("roll", 0) * kDeg;
-			// (x,y,z) = centre of the bottom face before pitch/roll
-			Pose3 base = Pose3::fromXYZYPR(x, y, z, yaw, pitch, roll);
-			Pose3 c = base;
-			c.t = base.apply(Eigen::Vector3d(0, 0, h.z()));
-			sc.solids.push_back(ConvexSolid::box(c, h, oi.id));
-		}
-		else if (kw == "wall")
-		{
-			ObjectInfo& oi = beginObject("wall");
-			const double x0 = a.req("x0"), y0 = a.req("y0"), x1 = a.req("x1"), y1 = a.req("y1");
-			const double th = a.pos("thickness", 0.10), hgt = a.pos("height", 2.5);
-			const double len = std::hypot(x1 - x0, y1 - y0);
-			if (len <= 0) a.fail("zero-length wall");
-			const double yaw = std::atan2(y1 - y0, x1 - x0);
-			Pose3 c = Pose3::fromXYZYPR(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * hgt, yaw, 0, 0);
-			sc.solids.push_back(ConvexSolid::box(c, Eigen::Vector3d(0.5 * len, 0.5 * th, 0.5 * hgt), oi.id));
-		}
-		else if (kw == "stairs_down" || kw == "stairs_up")
-		{
-			ObjectInfo& oi = beginObject(kw);
-			const double x = a.req("x"), y = a.req("y"), yaw = a.num("yaw", 0);
-			const double w = a.pos("width", 0, true), rise = a.pos("rise", 0, true), run = a.pos("run", 0, true);
-			const double stepsD = a.req("steps");
-			if (stepsD < 1 || stepsD != std::floor(stepsD) || stepsD > 100) a.fail("steps must be an integer in 1..100");
-			const int steps = int(stepsD);
-			const Pose3 f = planar(x, y, 0, yaw);
-			if (kw == "stairs_down")
-			{
-				const double landing = a.pos("landing", 1.0);
-				const double L = steps * run + landing, D = steps * rise;
-				Hole h;
-				h.shape = Hole::Rect;
-				const Eigen::Vector3d c = f.apply(Eigen::Vector3d(0.5 * L, 0, 0));
-				h.cx = c.x();
-				h.cy = c.y();
-				h.hx = 0.5 * L;
-				h.hy = 0.5 * w;
-				h.yaw = yaw * kDeg;
-				h.depth = D;
-				h.object_id = oi.id;
-				sc.holes.push_back(h);
-				// tread k (1..steps-1) at z = -k*rise over x in [(k-1)run, k run]
-				for (int k = 1; k < steps; k++)
-					sc.solids.push_back(localBox(
-						f, Eigen::Vector3d((k - 1) * run, -0.5 * w, -D),
-						Eigen::Vector3d(k * run, 0.5 * w, -k * rise), oi.id));
-			}
-			else
-			{
-				const double top = a.pos("top", 1.0);
-				const double L = steps * run + top;
-				for (int k = 1; k <= steps; k++)
-					sc.solids.push_back(localBox(
-						f, Eigen::Vector3d((k - 1) * run, -0.5 * w, 0), Eigen::Vector3d(L, 0.5 * w, k * rise),
-						oi.id));
-			}
-		}
-		else if (kw == "ramp")
-		{
-			ObjectInfo& oi = beginObject("ramp");
-			const double x = a.req("x"), y = a.req("y"), yaw = a.num("yaw", 0);
-			const double L = a.pos("length", 0, true), w = a.pos("width", 0, true);
-			const double ang = a.pos("angle", 0, true);
-			if (ang >= 60) a.fail("angle must be < 60 degrees");
-			oi.slope_deg = ang;
-			const std::string sides = a.str("sides", "solid");
-			const double th = a.pos("thickness", 0.03);
-			const double plateau = a.num("plateau", 0);
-			const bool back = a.num("back", 0) != 0;
-			if (plateau < 0) a.fail("plateau must be >= 0");
-			const double H = L * std::tan(ang * kDeg);
-			const Pose3 f = planar(x, y, 0, yaw);
-			auto addSlope = [&](const Pose3& fr) {
-				if (sides == "solid")
-					sc.solids.push_back(ConvexSolid::wedge(fr, L, w, ang * kDeg, oi.id));
-				else if (sides == "open")
-				{
-					// tilted plate: its top surface is the ramp surface
-					const double hyp = L / std::cos(ang * kDeg);
-					Pose3 tilt = fr * Pose3::fromXYZYPR(0, 0, 0, 0, -ang * kDeg, 0);
-					Pose3 c = tilt;
-					c.t = tilt.apply(Eigen::Vector3d(0.5 * hyp, 0, -0.5 * th));
-					sc.solids.push_back(ConvexSolid::box(c, Eigen::Vector3d(0.5 * hyp, 0.5 * w, 0.5 * th), oi.id));
-				}
-				else
-					a.fail("sides must be solid or open");
-			};
-			addSlope(f);
-			if (plateau > 0)
-				sc.solids.push_back(localBox(
-					f, Eigen::Vector3d(L, -0.5 * w, sides == "solid" ? 0.0 : H - th),
-					Eigen::Vector3d(L + plateau, 0.5 * w, H), oi.id));
-			if (back)
-				addSlope(f * planar(2 * L + plateau, 0, 0, 180.0));
-		}
-		else if (kw == "table")
-		{
-			ObjectInfo& oi = beginObject("table");
-			const Pose3 f = planar(a.req("x"), a.req("y"), 0, a.num("yaw", 0));
-			const double sx = a.pos("sx", 0, true), sy = a.pos("sy", 0, true);
-			const double H = a.pos("height", 0.75), top = a.pos("top", 0.04), leg = a.pos("leg", 0.05);
-			if (top >= H || 2 * leg >= std::min(sx, sy)) a.fail("inconsistent table sizes");
-			sc.solids.push_back(localBox(
-				f, Eigen::Vector3d(-0.5 * sx, -0.5 * sy, H - top), Eigen::Vector3d(0.5 * sx, 0.5 * sy, H), oi.id));
-			for (int i = 0; i < 4; i++)
-			{
-				const double lx = (i & 1) ? 0.5 * sx - leg : -0.5 * sx;
-				const double ly = (i & 2) ? 0.5 * sy - leg : -0.5 * sy;
-				sc.solids.push_back(localBox(
-					f, Eigen::Vector3d(lx, ly, 0), Eigen::Vector3d(lx + leg, ly + leg, H - top), oi.id));
-			}
-		}
-		else if (kw == "shelf")
-		{
-			ObjectInfo& oi = beginObject("shelf");
-			const Pose3 f = planar(a.req("x"), a.req("y"), 0, a.num("yaw", 0));
-			const double sx = a.pos("sx", 0, true), sy = a.pos("sy", 0, true), sz = a.pos("sz", 0, true);
-			const double nb = a.num("boards", 4), bt = a.pos("board", 0.02), side = a.pos("side", 0.02);
-			const double bottom = a.num("bottom", 0.10);
-			if (nb < 1 || nb != std::floor(nb) || nb > 50) a.fail("boards must be an integer in 1..50");
-			if (bottom < 0 || bottom + bt > sz || 2 * side >= sx) a.fail("inconsistent shelf sizes");
-			// sides at local x = +-sx/2 (the shelf's length runs along local x)
-			for (int s = -1; s <= 1; s += 2)
-			{
-				const double x0 = s < 0 ? -0.5 * sx : 0.5 * sx - side;
-				sc.solids.push_back(localBox(
-					f, Eigen::Vector3d(x0, -0.5 * sy, 0), Eigen::Vector3d(x0 + side, 0.5 * sy, sz), oi.id));
-			}
-			const int n = int(nb);
-			for (int b = 0; b < n; b++)
-			{
-				const double z = n == 1 ? bottom : bottom + b * (sz - bt - bottom) / (n - 1);
-				sc.solids.push_back(localBox(
-					f, Eigen::Vector3d(-0.5 * sx + side, -0.5 * sy, z),
-					Eigen::Vector3d(0.5 * sx - side, 0.5 * sy, z + bt), oi.id));
-			}
-		}
-		else if (kw == "path")
-		{
-			if (havePath) a.fail("only one path allowed");
-			havePath = true;
-			PathSpec& p = sf.path;
-			std::stringstream ws(a.str("waypoints", "", true));
-			std::string wp;
-			while (std::getline(ws, wp, ';'))
-			{
-				std::stringstream cs(wp);
-				std::string item;
-				std::vector<double> v;
-				while (std::getline(cs, item, ',')) v.push_back(a.toNum("waypoints", item));
-				if (v.size() != 3) a.fail("each waypoint needs x,y,yaw (got '" + wp + "')");
-				p.waypoints.push_back({v[0], v[1], v[2] * kDeg});
-			}
-			if (p.waypoints.empty()) a.fail("no waypoints");
-			p.spacing = a.pos("spacing", p.spacing);
-			p.turn_spacing = a.pos("turn_spacing", p.turn_spacing / kDeg) * kDeg;
-			const double fr = a.num("frames", 0);
-			if (fr < 0 || fr != std::floor(fr) || fr > 1e6) a.fail("frames must be an integer >= 0");
-			p.frames = int(fr);
-			p.rate_hz = a.pos("rate", p.rate_hz);
-		}
-		else if (kw == "odometry_noise")
-		{
-			auto& o = sf.odometry_noise;
-			o.xy_per_m = a.num("xy", 0);
-			o.yaw_per_m = a.num("yaw", 0) * kDeg;
-			o.yaw_per_rad = a.num("turn", 0);
-			if (o.xy_per_m < 0 || o.yaw_per_m < 0 || o.yaw_per_rad < 0) a.fail("noise must be >= 0");
-		}
-		else if (kw == "grid")
-		{
-			GridSpec& g = sf.grid;
-			g.resolution = a.pos("resolution", g.resolution);
-			g.min_x = a.req("min_x");
-			g.max_x = a.req("max_x");
-			g.min_y = a.req("min_y");
-			g.max_y = a.req("max_y");
-			if (g.max_x <= g.min_x || g.max_y <= g.min_y) a.fail("empty grid extent");
-			if ((g.max_x - g.min_x) / g.resolution * (g.max_y - g.min_y) / g.resolution > 5e7)
-				a.fail("grid too large");
-			g.robot_height = a.pos("robot_height", g.robot_height);
-			g.obstacle_min_height = a.pos("obstacle_min", g.obstacle_min_height);
-			g.drop_min_depth = a.pos("drop_min", g.drop_min_depth);
-			g.small_max_height = a.pos("small_max", g.small_max_height);
-			g.overhang_clearance = a.pos("overhang_clearance", g.overhang_clearance);
-			g.max_slope_deg = a.pos("max_slope", g.max_slope_deg);
-			const double ss = a.num("subsamples", g.subsamples);
-			if (ss < 1 || ss > 9 || ss != std::floor(ss)) a.fail("subsamples must be an integer in 1..9");
-			g.subsamples = int(ss);
-			sf.has_grid = true;
-		}
-		else
-			throw SceneError(where + ": unknown statement '" + kw + "'");
-
-		if (!sc.objects.empty() && sc.solids.size() + sc.holes.size() != s0 + h0)
-			finishObject(sc.objects.back().id, s0, h0);
+		st->parse(b, a);
+		if (!sc.objects.empty() && sc.solids.size() + sc.holes.size() != s0 + h0) finishObject(sc, s0, h0);
 		a.finish();
 	}
-	if (!havePath) throw SceneError(filename + ": no 'path' statement");
+	SceneFile& sf = b.sf;
+	if (!b.havePath) throw SceneError(filename + ": no 'path' statement");
 	if (!sf.has_grid)
 	{
 		// default: around the path, as far as the Kinect sees, plus all objects
-		Eigen::AlignedBox2d b;
-		b.setEmpty();
-		for (const auto& w : sf.path.waypoints) b.extend(Eigen::Vector2d(w.x, w.y));
+		Eigen::AlignedBox2d box;
+		box.setEmpty();
+		for (const auto& w : sf.path.waypoints) box.extend(Eigen::Vector2d(w.x, w.y));
 		const double m = sf.kinect.max_range + 0.5;
-		b.min() -= Eigen::Vector2d(m, m);
-		b.max() += Eigen::Vector2d(m, m);
-		sf.grid.min_x = std::floor(b.min().x());
-		sf.grid.min_y = std::floor(b.min().y());
-		sf.grid.max_x = std::ceil(b.max().x());
-		sf.grid.max_y = std::ceil(b.max().y());
+		box.min() -= Eigen::Vector2d(m, m);
+		box.max() += Eigen::Vector2d(m, m);
+		sf.grid.min_x = std::floor(box.min().x());
+		sf.grid.min_y = std::floor(box.min().y());
+		sf.grid.max_x = std::ceil(box.max().x());
+		sf.grid.max_y = std::ceil(box.max().y());
 	}
-	return sf;
+	return std::move(b.sf);
 }
 
 SceneFile parseSceneFile(const std::string& path)

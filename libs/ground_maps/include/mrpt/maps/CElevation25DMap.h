@@ -7,10 +7,9 @@
 #include <mrpt/obs/obs_frwds.h>
 #include <mrpt/poses/CPose3D.h>
 
-#include <mrpt/maps/gam_ini_fields.h>
 
-#include "gam/DepthProjector.h"
-#include "gam/ElevationGrid.h"
+#include "gam/core/DepthProjector.h"
+#include "gam/core/ElevationGrid.h"
 
 namespace mrpt::maps
 {
@@ -52,30 +51,33 @@ class CElevation25DMap : public CMetricMap
 	/** Re-creates the grid (empties it). Throws std::invalid_argument. */
 	void setSize(double x_min, double x_max, double y_min, double y_max, double resolution);
 
+	/** What is inserted and how: the projection band and ranges, the 3-sigma
+	 * rule and IDW. The keys are those of the core structs (declared once, in
+	 * gam/core: the ground-aware grid reads the same keys). */
 	struct TInsertionOptions : public mrpt::config::CLoadableOptions
 	{
-		float z_min = -2.0f;  ///< points outside [z_min, z_max] (map frame) are dropped [m]
-		float z_max = 3.0f;
-		float min_range = 0.0f;	 ///< [m] along the sensor axis / ray
-		float max_range = 10.0f;  ///< [m]; the observation's own maxRange applies too
-		int decimation = 1;	 ///< every n-th pixel row and column of range images
-		bool outlier_filter = true;	 ///< the 3-sigma rule per cell and frame
-		float outlier_sigmas = 3.0f;
-		int outlier_min_count = 4;
-		int idw_radius = 0;	 ///< cells; 0 = no densification
-		float idw_power = 2.0f;
-		int idw_min_neighbours = 3;
+		/** z_min, z_max in the map frame [m]; ranges along the sensor axis / ray
+		 * [m] (the observation's own maxRange applies too); decimation of range images. */
+		gam::ProjectionFilter projection = {0.0f, 10.0f, -2.0f, 3.0f, 1};
+		gam::OutlierFilterParams outliers;	///< the 3-sigma rule per cell and frame
+		gam::IdwParams idw = {0, 2.0f, 3};	///< radius 0 = no densification
 
-		/** Every .ini key of this struct with its range (see gam_ini_fields.h). */
-		gam::ini::Fields fields();
+		template <class Self, class Visit>
+		static void forEachParam(Self& o, Visit&& visit)
+		{
+			gam::ProjectionFilter::forEachParam(o.projection, visit);
+			gam::OutlierFilterParams::forEachParam(o.outliers, visit);
+			gam::IdwParams::forEachParam(o.idw, visit);
+		}
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 		/** Throws std::invalid_argument naming the key and the allowed range. */
 		void validate() const;
-		gam::OutlierFilterParams outlierParams() const;
-		gam::IdwParams idwParams() const;
-		gam::ProjectionFilter projectionFilter() const;
-	} insertionOptions;
+	};
+	const TInsertionOptions& insertionOptions() const { return m_options; }
+	/** Validates `o` (throws std::invalid_argument, keeping the current
+	 * options), then uses it for the next insertions. */
+	void setInsertionOptions(const TInsertionOptions& o);
 
 	/** The grid (read-only), for RRT-GPD, apps and tests. */
 	const gam::ElevationGrid& grid() const { return m_grid; }
@@ -127,6 +129,7 @@ class CElevation25DMap : public CMetricMap
    private:
 	void finishInsertion();
 
+	TInsertionOptions m_options;
 	gam::ElevationGrid m_grid;
 	// Scratch reused between insertions (not serialized).
 	gam::BinnedPoints m_bins;

@@ -1,13 +1,10 @@
 // Ground-aware mapping for MRPT
 #pragma once
 
+#include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
-#include <mrpt/maps/gam_ini_fields.h>
 
-#include "gam/DepthProjector.h"
-#include "gam/ElevationGrid.h"
-#include "gam/InverseSensorModel.h"
-#include "gam/RrtGroundDetector.h"
+#include "gam/core/GroundAwarePipeline.h"
 
 namespace mrpt::obs
 {
@@ -40,9 +37,13 @@ namespace mrpt::maps
  * ("local planes", option local_planes). With local_planes=false, one global
  * plane is used and a ramp rising more than d_pth above the floor is an obstacle.
  *
+ * The method itself is gam::GroundAwarePipeline (pure code, libs/ground_core);
+ * this class adapts observations to it and fuses its evidence in log-odds.
+ *
  * .ini: the standard COccupancyGridMap2D sections (_creationOpts,
  * _insertOpts, _likelihoodOpts) plus `[<prefix>_groundOpts]` with the keys of
- * TGroundAwareOptions (paper Table I names).
+ * TGroundAwareOptions (paper Table I names), listed once in the parameter
+ * structs of the core (forEachParam).
  */
 class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 {
@@ -56,41 +57,9 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	/** Every ground-aware parameter; defaults = paper Table I. */
 	struct TGroundAwareOptions : public mrpt::config::CLoadableOptions
 	{
-		// 2.5D map (d_r is the grid resolution, from _creationOpts)
-		int m_x = 200, m_y = 200;  ///< cells of the robot-centred 2.5D map
-		float z_min = -3.0f;  ///< points below robot-frame z (floor = 0) are dropped [m]
-		float z_max = 2.5f;	 ///< points above it are dropped [m]
-		float min_range = 0.0f, max_range = 5.0f;	///< sensor range limits [m]
-		int decimation = 1;
-		bool outlier_filter = true;
-		float outlier_sigmas = 3.0f;
-		int outlier_min_count = 4;
-		int idw_radius = 1;	 ///< IDW for the local plane fits [cells], 0 = off
-		// RRT-GPD
-		int K = 600;
-		double N_th = 0.2, E_th = 0.05;
-		int s_x = 3, s_y = 3;
-		double d_n = 0.4;
-		double max_cell_std = 0.05, max_fit_rms = 0.025;
-		int min_valid_cells = 5;
-		double seed_search_radius = 5.0, seed_height_tolerance = 0.3, window_margin = 1.0;
-		int seed_attempts = 3;
-		int min_nodes = 8, ransac_iterations = 100;
-		double ransac_inlier_distance = 0.025;
-		int min_nodes_per_extra_plane = 3, max_planes = 3;
-		int random_seed = 1;
-		// Inverse sensor model
-		double d_pth = 0.03, K_g = 0.3, sigma2 = 0.02, K_n = 0.0005, d_min = 3.0, K_m = 0.8;
-		double depth_noise_c0 = 0.0012, depth_noise_c2 = 0.0019, noise_sigmas = 3.0;
-		bool measure_floor_noise = true;
-		int floor_noise_min_cells = 10;
-		int min_obstacle_points = 2;
-		double robot_height = 1.8;
-		bool drop_rays = true;
-		double max_drop_ray_length = 2.0;
-		int drop_ray_min_points = 3;
-		bool local_planes = true;
-		double plane_support_radius = 0.4;
+		/** The method's parameters, nested per stage (2.5D map, outliers, IDW,
+		 * RRT-GPD, ISM); d_r is the grid resolution, from _creationOpts. */
+		gam::PipelineParams pipeline;
 		// 2D scans
 		int sparse_scan_upsampling = 8;	 ///< rays per beam for scans of < 64 beams (Leddar)
 		/** A planar beam passes over holes, cables and small boxes: with this
@@ -98,33 +67,41 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		 * never make an unknown or occupied cell freer (only seen floor is free). */
 		bool scan_keeps_3d_obstacles = true;
 
-		gam::ini::Fields fields();
+		/** Every `_groundOpts` key: the pipeline's, then the 2D-scan ones. */
+		template <class Self, class Visit>
+		static void forEachParam(Self& o, Visit&& visit)
+		{
+			gam::PipelineParams::forEachParam(o.pipeline, visit);
+			visit(gam::ParamInfo{"sparse_scan_upsampling", 1, 1000, "rays per beam for scans with < 64 beams"},
+				  o.sparse_scan_upsampling);
+			visit(gam::ParamInfo{"scan_keeps_3d_obstacles", 0, 1, "2D scans free only cells already free (seen floor)"},
+				  o.scan_keeps_3d_obstacles);
+		}
+		/** Loads and validates (throws std::invalid_argument naming the key). */
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 		/** Throws std::invalid_argument naming the key and its range. */
 		void validate() const;
-		gam::RrtGpdParams rrtParams() const;
-		gam::IsmParams ismParams() const;
-		gam::ProjectionFilter projectionFilter(double robotZ) const;
-		gam::OutlierFilterParams outlierParams() const;
-	} groundOptions;
-
-	/** What happened to the last 3D frame (for apps, viewers and logs). */
-	struct TFrameDiagnostics
-	{
-		bool valid = false;	 ///< a 3D frame was processed
-		gam::GroundDetection detection;
-		gam::IsmStats ism;
-		size_t points = 0;	///< points kept in the 2.5D map
-		Eigen::Vector3d sensor{0, 0, 0};  ///< sensor position (map frame)
-		double ms_projection = 0, ms_outliers = 0, ms_ground = 0, ms_ism = 0, ms_update = 0,
-			   ms_total = 0;
 	};
-	const TFrameDiagnostics& lastFrame() const { return m_last; }
+	/** The options in use (validated). */
+	const TGroundAwareOptions& groundOptions() const { return m_options; }
+	/** Validates `o` (throws std::invalid_argument and keeps the current
+	 * options if it is out of range), then uses it from the next frame on. */
+	void setGroundOptions(const TGroundAwareOptions& o);
+
+	/** Map-side times of the last 3D frame; the pipeline's stages are in lastFrame().ms. */
+	struct TFrameTimes
+	{
+		double update = 0;	///< log-odds fusion into this grid [ms]
+		double total = 0;  ///< the whole insertion [ms]
+	};
+	/** What happened to the last 3D frame (for apps, viewers and logs). */
+	const gam::FrameResult& lastFrame() const { return m_pipeline.result(); }
+	const TFrameTimes& lastFrameTimes() const { return m_times; }
 	/** The 2.5D map of the last 3D frame. */
-	const gam::ElevationGrid& lastFrameElevation() const { return m_frame; }
+	const gam::ElevationGrid& lastFrameElevation() const { return m_pipeline.frameGrid(); }
 	/** The ISM evidence and voxel classes of the last 3D frame (frame grid). */
-	const gam::InverseSensorModel& lastFrameIsm() const { return m_ism; }
+	const gam::InverseSensorModel& lastFrameIsm() const { return m_pipeline.ism(); }
 
 	/** Splits each beam of a sparse scan (< 64 beams, e.g. a 16-segment Leddar)
 	 * into k rays, so the base beam model covers each segment's full width. */
@@ -151,15 +128,11 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		const mrpt::obs::CObservation2DRangeScan& scan,
 		const std::optional<const mrpt::poses::CPose3D>& robotPose);
 	void applyEvidence();
-	void resetLastFrame();
 
-	// Per-frame workspace (not serialized).
-	gam::ElevationGrid m_frame;
-	gam::BinnedPoints m_bins;
-	gam::DepthProjector m_projector;
-	gam::RrtGroundDetector m_rrt;
-	gam::InverseSensorModel m_ism;
-	TFrameDiagnostics m_last;
+	TGroundAwareOptions m_options;
+	// The method and its per-frame workspace (not serialized).
+	gam::GroundAwarePipeline m_pipeline;
+	TFrameTimes m_times;
 };
 
 }  // namespace mrpt::maps

@@ -3,8 +3,7 @@
 
 namespace mrpt::maps
 {
-/** Registers CElevation25DMap, CGroundAwareOccupancyGrid and the comparison maps
- * CHeightBandOccupancyGrid and COctoMapGrid2D with MRPT's RTTI
+/** Registers CElevation25DMap and CGroundAwareOccupancyGrid with MRPT's RTTI
  * (deserialization) and map-type (.ini) registries. This already happens when
  * the library is loaded; an executable that links the library but uses none of
  * its symbols calls this so that `--as-needed` linking keeps the library. */

@@ -3,7 +3,9 @@
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/maps/COctoMap.h>
-#include <mrpt/maps/gam_ini_fields.h>
+#include <mrpt/config/CLoadableOptions.h>
+
+#include "gam/core/Parameters.h"
 
 namespace mrpt::maps
 {
@@ -55,7 +57,23 @@ class COctoMapGrid2D : public COccupancyGridMap2D
 		int project_every = 1;	///< re-project every n inserted frames; 0 = only on request / when saved
 		bool mark_free = true;	///< free voxels in the band make free cells
 
-		gam::ini::Fields fields();
+		template <class Self, class Visit>
+		static void forEachParam(Self& o, Visit&& visit)
+		{
+			using gam::ParamInfo;
+			visit(ParamInfo{"voxel_size", 0.005, 10, "octomap voxel size [m]"}, o.voxel_size);
+			visit(ParamInfo{"z_min", -100, 100, "lowest voxel-centre z projected [m]"}, o.z_min);
+			visit(ParamInfo{"z_max", -100, 100, "highest voxel-centre z projected (robot height) [m]"}, o.z_max);
+			visit(ParamInfo{"decimation", 1, 64, "use every n-th range-image pixel"}, o.decimation);
+			visit(ParamInfo{"max_range", 0.01, 1000, "rays are truncated at this range [m]"}, o.max_range);
+			visit(ParamInfo{"prob_hit", 0.5001, 1, "octomap hit probability"}, o.prob_hit);
+			visit(ParamInfo{"prob_miss", 0, 0.4999, "octomap miss probability"}, o.prob_miss);
+			visit(ParamInfo{"clamping_min", 0, 1, "octomap lower clamping probability"}, o.clamping_min);
+			visit(ParamInfo{"clamping_max", 0, 1, "octomap upper clamping probability"}, o.clamping_max);
+			visit(ParamInfo{"occupancy_thres", 0, 1, "a voxel is occupied above this probability"}, o.occupancy_thres);
+			visit(ParamInfo{"project_every", 0, 1000000, "re-project every n frames (0 = only when saved)"}, o.project_every);
+			visit(ParamInfo{"mark_free", 0, 1, "free voxels in the band make free cells"}, o.mark_free);
+		}
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 		void validate() const;

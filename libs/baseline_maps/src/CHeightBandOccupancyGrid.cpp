@@ -1,6 +1,8 @@
+#include <gam/maps/IniFields.h>
+#include <gam/maps/MapRegistry.h>
+#include <gam/maps/ObservationAdapters.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
-#include <mrpt/maps/gam_observation_adapters.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/T3DPointsTo2DScanParams.h>
@@ -15,6 +17,24 @@ MAP_DEFINITION_REGISTER(
 	"mrpt::maps::CHeightBandOccupancyGrid,heightBandGrid", mrpt::maps::CHeightBandOccupancyGrid)
 IMPLEMENTS_SERIALIZABLE(CHeightBandOccupancyGrid, COccupancyGridMap2D, mrpt::maps)
 
+namespace
+{
+// What tools need to know about this class (gam/maps/MapRegistry.h).
+const bool kTraitsRegistered = [] {
+	gam::maps::MapTraits t;
+	t.className = "mrpt::maps::CHeightBandOccupancyGrid";
+	t.sections = {
+		{"_creationOpts", gam::maps::gridCreationKeys()},
+		{"_insertOpts", {}},
+		{"_likelihoodOpts", {}},
+		{"_bandOpts", gam::maps::ini::keys<CHeightBandOccupancyGrid::THeightBandOptions>()}};
+	t.writeOutputs = gam::maps::writeGridOutputs;
+	t.keepWindow = gam::maps::keepGridWindow;
+	gam::maps::registerMapTraits(std::move(t));
+	return true;
+}();
+}  // namespace
+
 CHeightBandOccupancyGrid::TMapDefinition::TMapDefinition()
 {
 	// See the class comment: converted depth scans need these.
@@ -26,7 +46,7 @@ void CHeightBandOccupancyGrid::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
 {
 	const std::string sC = sectionNamePrefix + "_creationOpts";
-	gam::ini::loadGridExtent(source, sC, min_x, max_x, min_y, max_y, resolution);
+	gam::maps::ini::loadGridExtent(source, sC, min_x, max_x, min_y, max_y, resolution);
 	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 	likelihoodOpts.loadFromConfigFile(source, sectionNamePrefix + "_likelihoodOpts");
 	bandOpts.loadFromConfigFile(source, sectionNamePrefix + "_bandOpts");
@@ -53,30 +73,22 @@ mrpt::maps::CMetricMap* CHeightBandOccupancyGrid::internal_CreateFromMapDefiniti
 }
 
 // ---------------------------------------------------------------------------
-gam::ini::Fields CHeightBandOccupancyGrid::THeightBandOptions::fields()
-{
-	return {
-		{"z_min", &z_min, -100, 100, "lowest robot-frame z turned into the virtual scan [m]"},
-		{"z_max", &z_max, -100, 100, "highest robot-frame z turned into the virtual scan [m]"},
-		{"oversampling_ratio", &oversampling_ratio, 0.1, 10, "virtual rays per depth-image column"}};
-}
-
 void CHeightBandOccupancyGrid::THeightBandOptions::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& source, const std::string& section)
 {
-	gam::ini::loadThenCheck(fields(), source, section, [this] { validate(); });
+	gam::maps::ini::loadThenCheck(*this, source, section, [this] { validate(); });
 }
 
 void CHeightBandOccupancyGrid::THeightBandOptions::saveToConfigFile(
 	mrpt::config::CConfigFileBase& target, const std::string& section) const
 {
-	gam::ini::save(const_cast<THeightBandOptions*>(this)->fields(), target, section);
+	gam::maps::ini::save(*this, target, section);
 }
 
 void CHeightBandOccupancyGrid::THeightBandOptions::validate() const
 {
-	gam::ini::validate(const_cast<THeightBandOptions*>(this)->fields(), "bandOpts");
-	if (!(z_min < z_max)) throw std::invalid_argument("bandOpts: z_min must be < z_max");
+	gam::checkParamRanges(*this, "bandOpts:");
+	gam::requireParams(z_min < z_max, "bandOpts:", "z_min must be < z_max");
 }
 
 // ---------------------------------------------------------------------------
@@ -107,8 +119,8 @@ bool CHeightBandOccupancyGrid::internal_insertObservation(
 		auto& o3 = const_cast<CObservation3DRangeScan&>(dynamic_cast<const CObservation3DRangeScan&>(obs));
 		if (!o3.hasRangeImage || o3.rangeImage.cols() == 0) return false;
 		// MRPT trusts the intrinsics, image size and units: check them here.
-		gam::mrpt_glue::checkRangeScan(o3);
-		gam::mrpt_glue::checkScanGrowth(*this, pose + o3.sensorPose);
+		gam::maps::checkRangeScan(o3);
+		gam::maps::checkScanGrowth(*this, pose + o3.sensorPose);
 		T3DPointsTo2DScanParams sp;
 		sp.sensorLabel = o3.sensorLabel;
 		sp.use_origin_sensor_pose = true;
@@ -119,11 +131,11 @@ bool CHeightBandOccupancyGrid::internal_insertObservation(
 		o3.convertTo2DScan(m_lastScan, sp);
 		m_hasLastScan = true;
 		if (m_lastScan.getScanSize() == 0) return false;
-		m_lastScan = gam::mrpt_glue::safeScanFor(*this, m_lastScan, pose);
+		m_lastScan = gam::maps::safeScanFor(*this, m_lastScan, pose);
 		return COccupancyGridMap2D::internal_insertObservation(m_lastScan, robotPose);
 	}
 	if (const auto* o2 = dynamic_cast<const CObservation2DRangeScan*>(&obs))
-		return COccupancyGridMap2D::internal_insertObservation(gam::mrpt_glue::safeScanFor(*this, *o2, pose), robotPose);
+		return COccupancyGridMap2D::internal_insertObservation(gam::maps::safeScanFor(*this, *o2, pose), robotPose);
 	return COccupancyGridMap2D::internal_insertObservation(obs, robotPose);
 }
 
@@ -135,7 +147,7 @@ void CHeightBandOccupancyGrid::serializeTo(mrpt::serialization::CArchive& out) c
 {
 	out << COccupancyGridMap2D::serializeGetVersion();
 	COccupancyGridMap2D::serializeTo(out);
-	gam::ini::writeFields(const_cast<THeightBandOptions&>(bandOptions).fields(), out);
+	gam::maps::ini::write(bandOptions, out);
 }
 
 void CHeightBandOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version)
@@ -147,7 +159,7 @@ void CHeightBandOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in, 
 			uint8_t baseVer;
 			in >> baseVer;
 			COccupancyGridMap2D::serializeFrom(in, baseVer);
-			gam::ini::readFields(bandOptions.fields(), in, "CHeightBandOccupancyGrid");
+			gam::maps::ini::read(bandOptions, in, "CHeightBandOccupancyGrid");
 			m_hasLastScan = false;
 		}
 		break;

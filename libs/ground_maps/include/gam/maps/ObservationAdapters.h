@@ -1,6 +1,7 @@
 // Ground-aware mapping for MRPT
-// Glue between MRPT observations and the pure ground_core algorithms: turns
-// observations into BinnedPoints of an ElevationGrid.
+// Glue between MRPT observations and the pure ground_core algorithms: an
+// observation becomes a gam::SensorFrame (no copy of its samples), and the
+// checks that keep malformed observations and poses away from MRPT code.
 #pragma once
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
@@ -10,10 +11,11 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/poses/CPose3D.h>
 
-#include "gam/DepthProjector.h"
-#include "gam/ElevationGrid.h"
+#include "gam/core/DepthProjector.h"
+#include "gam/core/ElevationGrid.h"
+#include "gam/core/SensorFrame.h"
 
-namespace gam::mrpt_glue
+namespace gam::maps
 {
 /** CPose3D -> rigid transform (rotation + translation) in floats. */
 RigidTransform toRigid(const mrpt::poses::CPose3D& p);
@@ -21,23 +23,22 @@ RigidTransform toRigid(const mrpt::poses::CPose3D& p);
 /** Intrinsics of the depth camera of a 3D scan. */
 PinholeIntrinsics intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& o);
 
-/** Which points go into the 2.5D grid. Heights are in the grid (map) frame. */
-struct BinningOptions
-{
-	ProjectionFilter filter;
-	/** true: a depth/range beyond the observation's own maxRange is dropped too. */
-	bool use_observation_max_range = true;
-};
+/** Adapts a CObservation3DRangeScan (its range image, or its points3D if it
+ * has no range image) or a CObservationPointCloud taken from `robotPose`:
+ * the samples (referenced, not copied: `obs` must outlive `out`), the sensor
+ * pose in the map frame and the observation's own maxRange. Returns false for
+ * other classes; throws std::invalid_argument (naming the field) for
+ * non-finite poses and malformed observations. */
+bool toSensorFrame(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose, SensorFrame& out);
 
 /** Bins any supported observation taken from `robotPose` into `grid` bins:
- * CObservation3DRangeScan (from its range image, or its points3D if it has no
- * range image), CObservation2DRangeScan, CObservationPointCloud.
- * Returns false if the class is not supported; throws std::invalid_argument
- * (with a message naming the field) for malformed observations. */
+ * what toSensorFrame() adapts, and CObservation2DRangeScan. Heights are in the
+ * grid (map) frame. Returns false if the class is not supported; throws
+ * std::invalid_argument (with a message naming the field) for malformed
+ * observations. */
 bool binObservation(
-	const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose,
-	const BinningOptions& opts, const ElevationGrid& grid, DepthProjector& projector,
-	BinnedPoints& out, size_t* pointsBinned = nullptr);
+	const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose, const ProjectionFilter& filter,
+	const ElevationGrid& grid, DepthProjector& projector, BinnedPoints& out, size_t* pointsBinned = nullptr);
 
 /** Bins a point cloud given in the frame `pose` (points are first mapped by it). */
 size_t binPointCloud(
@@ -78,4 +79,4 @@ mrpt::obs::CObservation2DRangeScan safeScanFor(
 	const mrpt::maps::COccupancyGridMap2D& g, const mrpt::obs::CObservation2DRangeScan& in,
 	const mrpt::poses::CPose3D& robotPose);
 
-}  // namespace gam::mrpt_glue
+}  // namespace gam::maps

@@ -1,6 +1,9 @@
+#include <gam/maps/GridIO.h>
+#include <gam/maps/IniFields.h>
+#include <gam/maps/MapRegistry.h>
+#include <gam/maps/ObservationAdapters.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/maps/COctoMapGrid2D.h>
-#include <mrpt/maps/gam_observation_adapters.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -8,6 +11,11 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <filesystem>
+#include <unistd.h>
+#include <fcntl.h>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -17,13 +25,69 @@ using namespace mrpt::maps;
 MAP_DEFINITION_REGISTER("mrpt::maps::COctoMapGrid2D,octoMapGrid", mrpt::maps::COctoMapGrid2D)
 IMPLEMENTS_SERIALIZABLE(COctoMapGrid2D, COccupancyGridMap2D, mrpt::maps)
 
+namespace
+{
+// The 3D octomap itself, in OctoMap's own format (octovis, octomap tools).
+// liboctomap prints "Writing N nodes..." on stderr: keep the tool's stderr clean.
+void writeOctomapQuietly(const mrpt::maps::COctoMap& octo, const std::string& prefix)
+{
+	std::cerr.flush();
+	std::fflush(stderr);
+	const int saved = dup(2);
+	const int devnull = open("/dev/null", O_WRONLY);
+	if (devnull >= 0) dup2(devnull, 2);
+	auto restore = [&] {
+		std::cerr.flush();
+		std::fflush(stderr);
+		if (saved >= 0) dup2(saved, 2), close(saved);
+		if (devnull >= 0) close(devnull);
+	};
+	try
+	{
+		octo.saveMetricMapRepresentationToFile(prefix);
+	}
+	catch (...)
+	{
+		restore();
+		throw;
+	}
+	restore();
+}
+
+// What tools need to know about this class (gam/maps/MapRegistry.h).
+const bool kTraitsRegistered = [] {
+	gam::maps::MapTraits t;
+	t.className = "mrpt::maps::COctoMapGrid2D";
+	t.sections = {
+		{"_creationOpts", gam::maps::gridCreationKeys()},
+		{"_octoOpts", gam::maps::ini::keys<COctoMapGrid2D::TOctoOptions>()}};
+	t.writeOutputs = [](CMetricMap& m, const gam::maps::OutputContext& ctx, std::vector<std::string>& files) {
+		auto& oc = dynamic_cast<COctoMapGrid2D&>(m);
+		if (oc.projectionOutdated()) oc.updateProjection();
+		gam::maps::writeGridOutputs(oc, ctx, files);
+		const std::string base = ctx.dir + "/" + ctx.label;
+		writeOctomapQuietly(oc.octomap(), base + "_octomap");
+		for (const char* ext : {"_octomap_binary.bt", "_octomap_3D.3Dscene"})
+			if (std::filesystem::exists(base + ext)) files.push_back(ctx.label + ext);
+	};
+	t.stageTimes = [](const CMetricMap& m, bool, const gam::maps::StageSink& sink) {
+		const auto& oc = dynamic_cast<const COctoMapGrid2D&>(m);
+		sink("octomap_insert", oc.lastInsertionMs());
+		sink("projection", oc.lastProjectionMs());
+	};
+	t.keepWindow = gam::maps::keepGridWindow;
+	gam::maps::registerMapTraits(std::move(t));
+	return true;
+}();
+}  // namespace
+
 COctoMapGrid2D::TMapDefinition::TMapDefinition() = default;
 
 void COctoMapGrid2D::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
 {
 	const std::string sC = sectionNamePrefix + "_creationOpts";
-	gam::ini::loadGridExtent(source, sC, min_x, max_x, min_y, max_y, resolution);
+	gam::maps::ini::loadGridExtent(source, sC, min_x, max_x, min_y, max_y, resolution);
 	octoOpts.loadFromConfigFile(source, sectionNamePrefix + "_octoOpts");
 }
 
@@ -44,41 +108,23 @@ mrpt::maps::CMetricMap* COctoMapGrid2D::internal_CreateFromMapDefinition(const T
 }
 
 // ---------------------------------------------------------------------------
-gam::ini::Fields COctoMapGrid2D::TOctoOptions::fields()
-{
-	return {
-		{"voxel_size", &voxel_size, 0.005, 10, "octomap voxel size [m]"},
-		{"z_min", &z_min, -100, 100, "lowest voxel-centre z projected [m]"},
-		{"z_max", &z_max, -100, 100, "highest voxel-centre z projected (robot height) [m]"},
-		{"decimation", &decimation, 1, 64, "use every n-th range-image pixel"},
-		{"max_range", &max_range, 0.01, 1000, "rays are truncated at this range [m]"},
-		{"prob_hit", &prob_hit, 0.5001, 1, "octomap hit probability"},
-		{"prob_miss", &prob_miss, 0, 0.4999, "octomap miss probability"},
-		{"clamping_min", &clamping_min, 0, 1, "octomap lower clamping probability"},
-		{"clamping_max", &clamping_max, 0, 1, "octomap upper clamping probability"},
-		{"occupancy_thres", &occupancy_thres, 0, 1, "a voxel is occupied above this probability"},
-		{"project_every", &project_every, 0, 1000000, "re-project every n frames (0 = only when saved)"},
-		{"mark_free", &mark_free, 0, 1, "free voxels in the band make free cells"}};
-}
-
 void COctoMapGrid2D::TOctoOptions::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& source, const std::string& section)
 {
-	gam::ini::loadThenCheck(fields(), source, section, [this] { validate(); });
+	gam::maps::ini::loadThenCheck(*this, source, section, [this] { validate(); });
 }
 
 void COctoMapGrid2D::TOctoOptions::saveToConfigFile(
 	mrpt::config::CConfigFileBase& target, const std::string& section) const
 {
-	gam::ini::save(const_cast<TOctoOptions*>(this)->fields(), target, section);
+	gam::maps::ini::save(*this, target, section);
 }
 
 void COctoMapGrid2D::TOctoOptions::validate() const
 {
-	gam::ini::validate(const_cast<TOctoOptions*>(this)->fields(), "octoOpts");
-	if (!(z_min < z_max)) throw std::invalid_argument("octoOpts: z_min must be < z_max");
-	if (!(clamping_min < clamping_max))
-		throw std::invalid_argument("octoOpts: clamping_min must be < clamping_max");
+	gam::checkParamRanges(*this, "octoOpts:");
+	gam::requireParams(z_min < z_max, "octoOpts:", "z_min must be < z_max");
+	gam::requireParams(clamping_min < clamping_max, "octoOpts:", "clamping_min must be < clamping_max");
 }
 
 // ---------------------------------------------------------------------------
@@ -147,7 +193,7 @@ bool COctoMapGrid2D::internal_insertObservation(
 		const auto& o3 = dynamic_cast<const CObservation3DRangeScan&>(obs);
 		if (!o3.hasRangeImage && !o3.hasPoints3D) return false;
 		// MRPT's unprojectInto() trusts the intrinsics, image size and units: check them here.
-		gam::mrpt_glue::checkRangeScan(o3);
+		gam::maps::checkRangeScan(o3);
 		mrpt::maps::CSimplePointsMap pts;
 		pts.insertionOptions.minDistBetweenLaserPoints = 0;
 		if (o3.hasRangeImage)
@@ -242,7 +288,7 @@ void COctoMapGrid2D::updateProjection()
 	if (grow)
 	{
 		// Octomap keys span 65536 voxels per axis: far poses could need a huge 2D grid.
-		gam::mrpt_glue::checkGridSize("projecting the octomap", x0, x1, y0, y1, getResolution());
+		gam::maps::checkGridSize("projecting the octomap", x0, x1, y0, y1, getResolution());
 		resizeGrid(x0, x1, y0, y1, 0.5f, false);
 	}
 	fill(0.5f);
@@ -303,7 +349,7 @@ void COctoMapGrid2D::serializeTo(mrpt::serialization::CArchive& out) const
 	if (m_dirty) const_cast<COctoMapGrid2D*>(this)->updateProjection();
 	out << COccupancyGridMap2D::serializeGetVersion();
 	COccupancyGridMap2D::serializeTo(out);
-	gam::ini::writeFields(const_cast<TOctoOptions&>(octoOptions).fields(), out);
+	gam::maps::ini::write(octoOptions, out);
 	out << m_octomap;
 }
 
@@ -316,7 +362,7 @@ void COctoMapGrid2D::serializeFrom(mrpt::serialization::CArchive& in, uint8_t ve
 			uint8_t baseVer;
 			in >> baseVer;
 			COccupancyGridMap2D::serializeFrom(in, baseVer);
-			gam::ini::readFields(octoOptions.fields(), in, "COctoMapGrid2D");
+			gam::maps::ini::read(octoOptions, in, "COctoMapGrid2D");
 			in >> m_octomap;
 			m_dirty = false;
 			m_sinceProjection = 0;

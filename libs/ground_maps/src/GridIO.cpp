@@ -1,4 +1,4 @@
-#include <gam/mapper/GridIO.h>
+#include <gam/maps/GridIO.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace gam::mapper
+namespace gam::maps
 {
 using mrpt::maps::COccupancyGridMap2D;
 
@@ -59,12 +59,7 @@ COccupancyGridMap2D plainCopy(const COccupancyGridMap2D& g) { return COccupancyG
 
 void writePlainGridmapGz(const COccupancyGridMap2D& g, const std::string& path)
 {
-	const COccupancyGridMap2D plain = plainCopy(g);
-	mrpt::io::CFileGZOutputStream f;
-	if (!f.open(path, 6)) throw std::runtime_error("cannot write " + path);
-	auto ar = mrpt::serialization::archiveFrom(f);
-	ar << plain;
-	f.close();
+	writeSerializedGz(plainCopy(g), path);
 }
 
 PngView pngViewOf(const COccupancyGridMap2D& g)
@@ -163,4 +158,13 @@ COccupancyGridMap2D readGridmapGz(const std::string& path)
 	return g;
 }
 
-}  // namespace gam::mapper
+void writeSerializedGz(const mrpt::serialization::CSerializable& obj, const std::string& path)
+{
+	mrpt::io::CFileGZOutputStream f;
+	if (!f.open(path, 6)) throw std::runtime_error("cannot write " + path);
+	auto ar = mrpt::serialization::archiveFrom(f);
+	ar << obj;
+	f.close();
+}
+
+}  // namespace gam::maps

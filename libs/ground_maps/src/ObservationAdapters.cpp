@@ -1,11 +1,11 @@
-#include <mrpt/maps/gam_observation_adapters.h>
+#include <gam/maps/ObservationAdapters.h>
 #include <mrpt/obs/CObservationPointCloud.h>
 
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
-namespace gam::mrpt_glue
+namespace gam::maps
 {
 RigidTransform toRigid(const mrpt::poses::CPose3D& p)
 {
@@ -42,29 +42,6 @@ bool finitePose(const mrpt::poses::CPose3D& p)
 	return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()) &&
 		   std::isfinite(p.yaw()) && std::isfinite(p.pitch()) && std::isfinite(p.roll());
 }
-
-size_t binXYZ(
-	const float* xs, const float* ys, const float* zs, size_t n, const RigidTransform& T,
-	const ProjectionFilter& f, const ElevationGrid& grid, BinnedPoints& out)
-{
-	size_t binned = 0;
-	const bool rangeCheck = f.max_range < std::numeric_limits<float>::max() || f.min_range > 0;
-	const float min2 = f.min_range * f.min_range, max2 = f.max_range * f.max_range;
-	for (size_t i = 0; i < n; i++)
-	{
-		const Eigen::Vector3f p(xs[i], ys[i], zs[i]);
-		if (!p.allFinite()) continue;
-		if (rangeCheck)
-		{
-			const float r2 = p.squaredNorm();
-			if (r2 < min2 || r2 > max2) continue;
-		}
-		const Eigen::Vector3f q = T.R * p + T.t;
-		if (!(q.z() >= f.z_min && q.z() <= f.z_max)) continue;
-		if (grid.binPoint(q.x(), q.y(), q.z(), out)) binned++;
-	}
-	return binned;
-}
 }  // namespace
 
 size_t binPointCloud(
@@ -75,54 +52,86 @@ size_t binPointCloud(
 	const auto& xs = pts.getPointsBufferRef_x();
 	const auto& ys = pts.getPointsBufferRef_y();
 	const auto& zs = pts.getPointsBufferRef_z();
-	return binXYZ(xs.data(), ys.data(), zs.data(), pts.size(), toRigid(pose), f, grid, out);
+	return binPoints(xs.data(), ys.data(), zs.data(), pts.size(), toRigid(pose), f, grid, out);
 }
 
-bool binObservation(
-	const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose,
-	const BinningOptions& opts, const ElevationGrid& grid, DepthProjector& projector,
-	BinnedPoints& out, size_t* pointsBinned)
+namespace
+{
+void placeSensor(const mrpt::poses::CPose3D& sensorInMap, SensorFrame& out)
+{
+	out.sensor_to_map = toRigid(sensorInMap);
+	out.sensor_position = Eigen::Vector3d(sensorInMap.x(), sensorInMap.y(), sensorInMap.z());
+}
+}  // namespace
+
+bool toSensorFrame(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose, SensorFrame& out)
 {
 	using namespace mrpt::obs;
 	if (!finitePose(robotPose)) throw std::invalid_argument("robot pose is not finite");
-	size_t n = 0;
-	ProjectionFilter f = opts.filter;
+	out = SensorFrame{};
 	if (const auto* o3 = dynamic_cast<const CObservation3DRangeScan*>(&obs))
 	{
 		o3->load();	 // externally stored images
 		if (!finitePose(o3->sensorPose))
 			throw std::invalid_argument("CObservation3DRangeScan.sensorPose is not finite");
-		if (opts.use_observation_max_range && o3->maxRange > 0)
-			f.max_range = std::min(f.max_range, o3->maxRange);
-		const mrpt::poses::CPose3D sensorInMap = robotPose + o3->sensorPose;
+		if (o3->maxRange > 0) out.max_range = o3->maxRange;
+		placeSensor(robotPose + o3->sensorPose, out);
 		if (o3->hasRangeImage && o3->rangeImage.rows() > 0)
 		{
-			RangeImageView v;
-			v.data = o3->rangeImage.data();
-			v.rows = int(o3->rangeImage.rows());
-			v.cols = int(o3->rangeImage.cols());
-			v.stride = size_t(o3->rangeImage.cols());
-			v.units = o3->rangeUnits;
-			v.is_depth = o3->range_is_depth;
+			out.has_image = true;
 			// CMatrix_u16 is row-major (Eigen::RowMajor), so data() walks rows.
-			n = projector.project(v, intrinsicsOf(*o3), toRigid(sensorInMap), f, grid, out);
+			out.image.data = o3->rangeImage.data();
+			out.image.rows = int(o3->rangeImage.rows());
+			out.image.cols = int(o3->rangeImage.cols());
+			out.image.stride = size_t(o3->rangeImage.cols());
+			out.image.units = o3->rangeUnits;
+			out.image.is_depth = o3->range_is_depth;
+			out.intrinsics = intrinsicsOf(*o3);
 		}
 		else if (o3->hasPoints3D)
 		{
 			const size_t np = o3->points3D_x.size();
 			if (o3->points3D_y.size() != np || o3->points3D_z.size() != np)
 				throw std::invalid_argument("CObservation3DRangeScan.points3D_x/y/z sizes differ");
-			n = binXYZ(
-				o3->points3D_x.data(), o3->points3D_y.data(), o3->points3D_z.data(), np,
-				toRigid(sensorInMap), f, grid, out);
+			out.x = o3->points3D_x.data();
+			out.y = o3->points3D_y.data();
+			out.z = o3->points3D_z.data();
+			out.point_count = np;
 		}
+		return true;
 	}
+	if (const auto* pc = dynamic_cast<const CObservationPointCloud*>(&obs))
+	{
+		pc->load();
+		if (!pc->pointcloud) return true;  // nothing to bin
+		if (!finitePose(pc->sensorPose))
+			throw std::invalid_argument("CObservationPointCloud.sensorPose is not finite");
+		placeSensor(robotPose + pc->sensorPose, out);
+		const auto& P = *pc->pointcloud;
+		out.x = P.getPointsBufferRef_x().data();
+		out.y = P.getPointsBufferRef_y().data();
+		out.z = P.getPointsBufferRef_z().data();
+		out.point_count = P.size();
+		return true;
+	}
+	return false;
+}
+
+bool binObservation(
+	const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose, const ProjectionFilter& filter,
+	const ElevationGrid& grid, DepthProjector& projector, BinnedPoints& out, size_t* pointsBinned)
+{
+	using namespace mrpt::obs;
+	size_t n = 0;
+	SensorFrame frame;
+	if (toSensorFrame(obs, robotPose, frame))
+		n = binSensorFrame(frame, filter, grid, projector, out);
 	else if (const auto* o2 = dynamic_cast<const CObservation2DRangeScan*>(&obs))
 	{
 		if (!finitePose(o2->sensorPose))
 			throw std::invalid_argument("CObservation2DRangeScan.sensorPose is not finite");
-		if (opts.use_observation_max_range && o2->maxRange > 0)
-			f.max_range = std::min(f.max_range, o2->maxRange);
+		ProjectionFilter f = filter;
+		if (o2->maxRange > 0) f.max_range = std::min(f.max_range, o2->maxRange);
 		// Sensor-frame points of the valid beams (range limits apply to them).
 		const size_t N = o2->getScanSize();
 		std::vector<float> xs, ys, zs;
@@ -138,17 +147,7 @@ bool binObservation(
 			ys.push_back(r * std::sin(a));
 		}
 		zs.assign(xs.size(), 0.f);
-		n = binXYZ(
-			xs.data(), ys.data(), zs.data(), xs.size(), toRigid(robotPose + o2->sensorPose), f,
-			grid, out);
-	}
-	else if (const auto* pc = dynamic_cast<const CObservationPointCloud*>(&obs))
-	{
-		pc->load();
-		if (!pc->pointcloud) return true;
-		if (!finitePose(pc->sensorPose))
-			throw std::invalid_argument("CObservationPointCloud.sensorPose is not finite");
-		n = binPointCloud(*pc->pointcloud, robotPose + pc->sensorPose, f, grid, out);
+		n = binPoints(xs.data(), ys.data(), zs.data(), xs.size(), toRigid(robotPose + o2->sensorPose), f, grid, out);
 	}
 	else
 		return false;
@@ -226,4 +225,4 @@ mrpt::obs::CObservation2DRangeScan safeScanFor(
 	return out;
 }
 
-}  // namespace gam::mrpt_glue
+}  // namespace gam::maps

@@ -4,12 +4,13 @@
 #pragma once
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/serialization/CSerializable.h>
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-namespace gam::mapper
+namespace gam::maps
 {
 /** PGM grey level of a cell: round(255 * (1 - p_occupied)) = round(255 * p_free),
  * p_free = COccupancyGridMap2D::l2p(cell). */
@@ -47,6 +48,9 @@ constexpr uint8_t kUnknownR = 190, kUnknownG = 205, kUnknownB = 235;
 /** A plain copy (slices a derived grid). */
 mrpt::maps::COccupancyGridMap2D plainCopy(const mrpt::maps::COccupancyGridMap2D& grid);
 
+/** `obj` serialized into a gzip file (MRPT's archive format: stock tools read
+ * it with archiveFrom(CFileGZInputStream(path)) >> obj). Throws std::runtime_error. */
+void writeSerializedGz(const mrpt::serialization::CSerializable& obj, const std::string& path);
 /** Crops / extends `grid` to a window of n x n cells centred on (cx, cy),
  * keeping the cell alignment and the log-odds of the cells inside; new cells
  * are unknown. Returns true if the grid changed. */
@@ -58,4 +62,4 @@ bool recentreGrid(mrpt::maps::COccupancyGridMap2D& grid, double cx, double cy, i
 /** Reads a .gridmap / .gridmap.gz as a stock COccupancyGridMap2D. */
 mrpt::maps::COccupancyGridMap2D readGridmapGz(const std::string& path);
 
-}  // namespace gam::mapper
+}  // namespace gam::maps

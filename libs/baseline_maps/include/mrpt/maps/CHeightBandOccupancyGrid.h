@@ -2,7 +2,9 @@
 #pragma once
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
-#include <mrpt/maps/gam_ini_fields.h>
+#include <mrpt/config/CLoadableOptions.h>
+
+#include "gam/core/Parameters.h"
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
 namespace mrpt::maps
@@ -43,7 +45,13 @@ class CHeightBandOccupancyGrid : public COccupancyGridMap2D
 		double z_max = 1.5;	 ///< highest robot-frame z kept [m]
 		double oversampling_ratio = 1.2;  ///< virtual rays = image width * this
 
-		gam::ini::Fields fields();
+		template <class Self, class Visit>
+		static void forEachParam(Self& o, Visit&& visit)
+		{
+			visit(gam::ParamInfo{"z_min", -100, 100, "lowest robot-frame z turned into the virtual scan [m]"}, o.z_min);
+			visit(gam::ParamInfo{"z_max", -100, 100, "highest robot-frame z turned into the virtual scan [m]"}, o.z_max);
+			visit(gam::ParamInfo{"oversampling_ratio", 0.1, 10, "virtual rays per depth-image column"}, o.oversampling_ratio);
+		}
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 		/** Throws std::invalid_argument naming the key and its range. */

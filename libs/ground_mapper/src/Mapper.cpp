@@ -1,0 +1,305 @@
+#include <gam/mapper/Errors.h>
+#include <gam/mapper/Mapper.h>
+#include <gam/mapper/RawlogFrames.h>
+#include <gam/maps/MapRegistry.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using namespace mrpt::maps;
+
+namespace gam::mapper
+{
+namespace
+{
+std::string firstLine(const std::string& s) { return conciseError(s); }
+
+std::string fmtMs(double v)
+{
+	std::ostringstream s;
+	s << std::fixed << std::setprecision(3) << v;
+	return s.str();
+}
+}  // namespace
+
+// ---------------------------------------------------------------------------
+double percentile(std::vector<double> v, double p)
+{
+	if (v.empty()) return 0;
+	std::sort(v.begin(), v.end());
+	const double pos = p * double(v.size() - 1);
+	const size_t i = size_t(std::floor(pos));
+	const double f = pos - double(i);
+	return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v.back();
+}
+double MapTiming::median() const { return percentile(ms3D.empty() ? totalMs : ms3D, 0.5); }
+double MapTiming::p95() const { return percentile(ms3D.empty() ? totalMs : ms3D, 0.95); }
+
+std::string RunSummary::text() const
+{
+	std::ostringstream s;
+	s << "frames: " << frames << " (" << frames3D << " 3D scans, " << frames2D << " 2D scans";
+	if (framesWithoutOdometry) s << ", " << framesWithoutOdometry << " without odometry: robot at the origin";
+	s << ") in " << std::fixed << std::setprecision(2) << seconds << " s\n";
+	size_t wl = 5, wc = 5;
+	for (const auto& m : maps) wl = std::max(wl, m.label.size()), wc = std::max(wc, m.className.size());
+	const bool both = frames3D > 0 && frames2D > 0;
+	if (both) s << "median / p95 over the 3D frames; 2D-scan frames in the last two columns\n";
+	s << std::left << std::setw(int(wl) + 2) << "map" << std::setw(int(wc) + 2) << "class" << std::right
+	  << std::setw(12) << "median_ms" << std::setw(12) << "p95_ms";
+	if (both) s << std::setw(12) << "2d_median" << std::setw(12) << "2d_p95";
+	s << "\n";
+	for (const auto& m : maps)
+	{
+		s << std::left << std::setw(int(wl) + 2) << m.label << std::setw(int(wc) + 2) << m.className
+		  << std::right << std::setw(12) << fmtMs(m.median()) << std::setw(12) << fmtMs(m.p95());
+		if (both)
+			s << std::setw(12) << fmtMs(percentile(m.ms2D, 0.5)) << std::setw(12) << fmtMs(percentile(m.ms2D, 0.95));
+		s << "\n";
+	}
+	return s.str();
+}
+
+// ---------------------------------------------------------------------------
+Mapper::Mapper(const MapperOptions& opts) : m_opts(opts)
+{
+	if (m_opts.localCells < 10 || m_opts.localCells > 100000)
+		throw ConfigError("--local-size-cells=" + std::to_string(m_opts.localCells) + " is out of range [10, 100000]");
+	mrpt::config::CConfigFileMemory ini(m_opts.configText);
+	TSetOfMetricMapInitializers inits;
+	try
+	{
+		loadMapDefinitions(ini, m_opts.section, inits, m_specs, &m_warnings);
+	}
+	catch (const ConfigError& e)
+	{
+		throw ConfigError(m_opts.configName + ": " + e.what());
+	}
+	try
+	{
+		m_maps.setListOfMaps(inits);
+	}
+	catch (const std::exception& e)
+	{
+		throw ConfigError(m_opts.configName + ": cannot create the maps: " + firstLine(e.what()));
+	}
+	if (m_maps.maps.size() != m_specs.size())
+		throw ConfigError("internal: CMultiMetricMap created a different number of maps than the .ini defines");
+	for (size_t i = 0; i < m_specs.size(); i++)
+		if (m_maps.maps[i]->GetRuntimeClass()->className != m_specs[i].className)
+			throw ConfigError("internal: CMultiMetricMap map order differs from the .ini order");
+}
+
+namespace
+{
+struct TmpDir
+{
+	std::string path;
+	bool keep = false;
+	~TmpDir()
+	{
+		if (!path.empty() && !keep)
+		{
+			std::error_code ec;
+			fs::remove_all(path, ec);
+		}
+	}
+};
+
+bool stderrIsTty() { return isatty(2) != 0; }
+}  // namespace
+
+RunSummary Mapper::run()
+{
+	using clk = std::chrono::steady_clock;
+	const auto tStart = clk::now();
+	RunSummary s;
+
+	// 1. Input (before touching DIR).
+	std::unique_ptr<RawlogFrameReader> reader;
+	try
+	{
+		reader = std::make_unique<RawlogFrameReader>(m_opts.rawlogPath);
+	}
+	catch (const std::exception& e)
+	{
+		throw RunError(e.what());
+	}
+
+	// 2. Output directory: create it and a private temporary folder inside it,
+	// so nothing in DIR looks like a finished map until the very end.
+	std::error_code ec;
+	fs::create_directories(m_opts.outDir, ec);
+	if (!fs::is_directory(m_opts.outDir))
+		throw RunError("cannot create output directory " + m_opts.outDir + (ec ? ": " + ec.message() : ""));
+	TmpDir tmp;
+	tmp.path = (fs::path(m_opts.outDir) / (".ground-aware-mapper.tmp." + std::to_string(getpid()))).string();
+	fs::remove_all(tmp.path, ec);
+	if (!fs::create_directory(tmp.path, ec))
+		throw RunError("output directory " + m_opts.outDir + " is not writable" + (ec ? ": " + ec.message() : ""));
+
+	std::ofstream timing(tmp.path + "/timing.csv"), planes(tmp.path + "/ground_planes.csv");
+	if (!timing || !planes) throw RunError("cannot write to " + tmp.path);
+	timing << "frame,map,stage,ms\n";
+	planes << "frame,a,b,c,d,nodes,status\n";
+	planes << std::setprecision(9);
+	timing << std::fixed << std::setprecision(4);
+
+	s.maps.resize(m_specs.size());
+	for (size_t i = 0; i < m_specs.size(); i++)
+	{
+		s.maps[i].label = m_specs[i].label;
+		s.maps[i].className = m_specs[i].className;
+	}
+	// Each map's traits (gam/maps/MapRegistry.h); the first map that finds
+	// ground planes writes ground_planes.csv.
+	std::vector<const gam::maps::MapTraits*> traits(m_specs.size());
+	int planesFrom = -1;
+	for (size_t i = 0; i < m_specs.size(); i++)
+	{
+		traits[i] = gam::maps::findMapTraits(*m_maps.maps[i]);
+		if (planesFrom < 0 && traits[i] && traits[i]->lastGroundPlane) planesFrom = int(i);
+	}
+
+	// 3. Frames.
+	const bool tty = stderrIsTty();
+	bool progressShown = false;
+	auto clearProgress = [&] {
+		if (progressShown && tty) std::cerr << "\r" << std::string(78, ' ') << "\r" << std::flush;
+		progressShown = false;
+	};
+	auto lastProgress = clk::now();
+	Frame fr;
+	try
+	{
+		while (true)
+		{
+			if (m_opts.stopRequested && *m_opts.stopRequested) throw RunError("interrupted");
+			try
+			{
+				if (!reader->next(fr)) break;
+			}
+			catch (const std::exception& e)
+			{
+				throw RunError(e.what());
+			}
+			if (m_opts.maxFrames && fr.index >= m_opts.maxFrames) break;
+			const bool is3D = IS_CLASS(*fr.obs, mrpt::obs::CObservation3DRangeScan);
+			s.frames++;
+			(is3D ? s.frames3D : s.frames2D)++;
+			if (!fr.hasOdometry) s.framesWithoutOdometry++;
+
+			for (size_t i = 0; i < m_specs.size(); i++)
+			{
+				auto& map = *m_maps.maps[i];
+				const auto t0 = clk::now();
+				try
+				{
+					map.insertObservation(*fr.obs, fr.robotPose);
+				}
+				catch (const std::exception& e)
+				{
+					throw RunError(
+						"frame " + std::to_string(fr.index) + " (rawlog entry " + std::to_string(fr.entry) + "), map " +
+						m_specs[i].label + ": " + firstLine(e.what()));
+				}
+				const double ms = std::chrono::duration<double, std::milli>(clk::now() - t0).count();
+				s.maps[i].totalMs.push_back(ms);
+				(is3D ? s.maps[i].ms3D : s.maps[i].ms2D).push_back(ms);
+				const std::string& L = m_specs[i].label;
+				timing << fr.index << "," << L << ",total," << ms << "\n";
+				const gam::maps::MapTraits* t = traits[i];
+				if (t && t->stageTimes)
+					t->stageTimes(map, is3D, [&](const char* stage, double stageMs) {
+						timing << fr.index << "," << L << "," << stage << "," << stageMs << "\n";
+					});
+				gam::maps::GroundPlaneRecord gp;
+				if (int(i) == planesFrom && is3D && t->lastGroundPlane(map, gp))
+				{
+					planes << fr.index << ",";
+					if (gp.found)
+						planes << gp.a << "," << gp.b << "," << gp.c << "," << gp.d;
+					else
+						planes << ",,,";
+					planes << "," << gp.nodes << "," << gp.status << "\n";
+				}
+			}
+
+			m_lastPose = fr.robotPose;
+			if (m_opts.localMap)
+				for (size_t i = 0; i < m_specs.size(); i++)
+					if (traits[i] && traits[i]->keepWindow)
+						traits[i]->keepWindow(*m_maps.maps[i], fr.robotPose.x(), fr.robotPose.y(), m_opts.localCells);
+
+			if (m_opts.progress)
+			{
+				const auto now = clk::now();
+				const double since = std::chrono::duration<double>(now - lastProgress).count();
+				if (since >= (tty ? 0.5 : 5.0))
+				{
+					lastProgress = now;
+					const double el = std::chrono::duration<double>(now - tStart).count();
+					std::cerr << (tty ? "\r" : "") << "ground-aware-mapper: frame " << s.frames << ", rawlog entry "
+							  << reader->entriesRead() << ", " << std::fixed << std::setprecision(1)
+							  << (el > 0 ? double(s.frames) / el : 0.0) << " frames/s, " << el << " s"
+							  << (tty ? "   " : "\n") << std::flush;
+					progressShown = true;
+				}
+			}
+		}
+	}
+	catch (...)
+	{
+		clearProgress();
+		throw;
+	}
+	clearProgress();
+	if (s.frames == 0)
+		throw RunError(
+			"no usable observation in " + m_opts.rawlogPath + " (" + std::to_string(reader->entriesRead()) +
+			" entries; need CObservation3DRangeScan or CObservation2DRangeScan with data)");
+
+	timing.close();
+	planes.close();
+	if (!timing || !planes) throw RunError("cannot write timing.csv / ground_planes.csv in " + tmp.path);
+
+	// 4. Maps.
+	try
+	{
+		writeMaps(tmp.path, s);
+		std::ofstream cfg(tmp.path + "/config_used.ini");
+		cfg << m_opts.configText;
+		if (!cfg) throw std::runtime_error("cannot write config_used.ini");
+	}
+	catch (const std::exception& e)
+	{
+		throw RunError("writing outputs: " + firstLine(e.what()));
+	}
+	s.files.push_back("timing.csv");
+	s.files.push_back("ground_planes.csv");
+	s.files.push_back("config_used.ini");
+
+	// 5. Publish: move everything into DIR.
+	for (const auto& f : s.files)
+	{
+		fs::rename(fs::path(tmp.path) / f, fs::path(m_opts.outDir) / f, ec);
+		if (ec) throw RunError("cannot move " + f + " into " + m_opts.outDir + ": " + ec.message());
+	}
+	s.seconds = std::chrono::duration<double>(clk::now() - tStart).count();
+	return s;
+}
+
+}  // namespace gam::mapper

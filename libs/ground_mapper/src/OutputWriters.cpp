@@ -1,0 +1,52 @@
+// ground-aware-mapper's outputs: each map writes what its traits say
+// (gam/maps/MapRegistry.h); a map with no traits (a stock MRPT map) writes
+// MRPT's own representation and the serialized object.
+#include <gam/mapper/Mapper.h>
+#include <gam/maps/GridIO.h>
+#include <gam/maps/MapRegistry.h>
+
+#include <filesystem>
+#include <set>
+
+namespace fs = std::filesystem;
+
+namespace gam::mapper
+{
+void Mapper::writeMaps(const std::string& dir, RunSummary& s)
+{
+	for (size_t i = 0; i < m_specs.size(); i++)
+	{
+		auto& map = *m_maps.maps[i];
+		const std::string L = m_specs[i].label;
+		const std::string base = dir + "/" + L;
+		if (const gam::maps::MapTraits* t = gam::maps::findMapTraits(map); t && t->writeOutputs)
+		{
+			gam::maps::OutputContext ctx;
+			ctx.dir = dir;
+			ctx.label = L;
+			ctx.localMap = m_opts.localMap;
+			ctx.robotX = m_lastPose.x();
+			ctx.robotY = m_lastPose.y();
+			ctx.localCells = m_opts.localCells;
+			t->writeOutputs(map, ctx, s.files);
+		}
+		else
+		{
+			// Any other map of the .ini: MRPT's own representation + the serialized object.
+			const auto before = [&] {
+				std::set<std::string> n;
+				for (const auto& de : fs::directory_iterator(dir)) n.insert(de.path().filename().string());
+				return n;
+			}();
+			map.saveMetricMapRepresentationToFile(base);
+			gam::maps::writeSerializedGz(map, base + ".map.gz");
+			for (const auto& de : fs::directory_iterator(dir))
+			{
+				const auto n = de.path().filename().string();
+				if (!before.count(n) && de.is_regular_file()) s.files.push_back(n);
+			}
+		}
+	}
+}
+
+}  // namespace gam::mapper
