@@ -1,6 +1,6 @@
 // Ground-aware mapping for MRPT -- gam-evaluate: scores 2D occupancy maps (ROS
 // map_server yaml + pgm, as ground-aware-mapper writes them) against the ground
-// truth of gam-simulate. See README "Map evaluator" and libs/evaluation.
+// truth of gam-simulate. See README "Map evaluator" and libs/ground_eval.
 //
 // usage: gam-evaluate --map DIR/ground_aware.yaml [--map DIR/octomap.yaml ...]
 //                     --gt PREFIX [--json FILE] [--csv FILE] [--png FILE]

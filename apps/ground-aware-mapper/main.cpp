@@ -1,5 +1,5 @@
 // ground-aware-mapper: builds the ground-aware grid and the comparison maps
-// from a rawlog. All the work is in libs/mapper (gam::mapper::Mapper).
+// from a rawlog. All the work is in libs/ground_mapper (gam::mapper::Mapper).
 #include <default_config.h>
 #include <gam/mapper/Errors.h>
 #include <gam/mapper/Mapper.h>

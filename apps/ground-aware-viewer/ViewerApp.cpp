@@ -11,6 +11,8 @@
 // CFBORender into DIR/<view>.png and exits: no display needed.
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/gui/CWxGLCanvasBase.h>
+#include <gam/maps/IniFields.h>
+#include <mrpt/maps/registerBaselineMaps.h>
 #include <mrpt/maps/registerGroundAwareMaps.h>
 #include <wx/dirdlg.h>
 #include <wx/filedlg.h>
@@ -239,36 +241,40 @@ class ViewerFrame : public wxFrame
 	}
 
    private:
+	using Options = mrpt::maps::CGroundAwareOccupancyGrid::TGroundAwareOptions;
+
+	/** The panel group of a key: the stage whose parameter struct declares it. */
 	static const char* groupOf(const std::string& key)
 	{
-		static const std::set<std::string> map25 = {"m_x", "m_y", "z_min", "z_max", "min_range", "max_range", "decimation", "outlier_filter", "outlier_sigmas", "outlier_min_count", "idw_radius"};
-		static const std::set<std::string> ism = {"d_pth", "K_g", "sigma2", "K_n", "d_min", "K_m", "depth_noise_c0", "depth_noise_c2", "noise_sigmas", "robot_height", "drop_rays", "max_drop_ray_length", "drop_ray_min_points", "local_planes", "plane_support_radius"};
-		static const std::set<std::string> scans = {"sparse_scan_upsampling", "scan_keeps_3d_obstacles"};
-		if (map25.count(key)) return "2.5D map";
-		if (ism.count(key)) return "Inverse sensor model";
-		if (scans.count(key)) return "2D scans";
-		return "RRT-GPD";
+		static const auto rrt = gam::maps::ini::keys<gam::RrtGpdParams>();
+		static const auto ism = gam::maps::ini::keys<gam::IsmParams>();
+		static const auto pipeline = gam::maps::ini::keys<gam::PipelineParams>();
+		auto has = [&](const std::vector<std::string>& v) { return std::find(v.begin(), v.end(), key) != v.end(); };
+		if (has(rrt)) return "RRT-GPD";
+		if (has(ism)) return "Inverse sensor model";
+		if (has(pipeline)) return "2.5D map";
+		return "2D scans";
 	}
 
 	void fillProperties()
 	{
 		m_props->Clear();
-		auto opts = m_model.groundOptions();
 		std::map<std::string, wxPGProperty*> cats;
 		for (const char* c : {"RRT-GPD", "Inverse sensor model", "2.5D map", "2D scans"})
 			cats[c] = m_props->Append(new wxPropertyCategory(c));
-		for (const auto& f : opts.fields())
-		{
+		Options::forEachParam(m_model.groundOptions(), [&](const gam::ParamInfo& info, const auto& v) {
+			using T = std::decay_t<decltype(v)>;
+			const wxString name(info.key);
 			wxPGProperty* p = nullptr;
-			const wxString name(f.key);
-			if (auto d = std::get_if<double*>(&f.var)) p = new wxFloatProperty(name, name, **d);
-			else if (auto fl = std::get_if<float*>(&f.var)) p = new wxFloatProperty(name, name, double(**fl));
-			else if (auto i = std::get_if<int*>(&f.var)) p = new wxIntProperty(name, name, **i);
-			else if (auto b = std::get_if<bool*>(&f.var)) p = new wxBoolProperty(name, name, **b);
-			if (!p) continue;
-			p->SetHelpString(wxString::Format("%s [%g, %g]", f.help, f.lo, f.hi));
-			m_props->AppendIn(cats[groupOf(f.key)], p);
-		}
+			if constexpr (std::is_same_v<T, bool>)
+				p = new wxBoolProperty(name, name, v);
+			else if constexpr (std::is_integral_v<T>)
+				p = new wxIntProperty(name, name, long(v));
+			else
+				p = new wxFloatProperty(name, name, double(v));
+			p->SetHelpString(wxString::Format("%s [%g, %g]", info.help, info.lo, info.hi));
+			m_props->AppendIn(cats[groupOf(info.key)], p);
+		});
 		m_props->SetPropertyAttributeAll(wxPG_BOOL_USE_CHECKBOX, true);
 	}
 
@@ -277,27 +283,27 @@ class ViewerFrame : public wxFrame
 		wxPGProperty* p = ev.GetProperty();
 		if (!p || p->IsCategory()) return;
 		const std::string key = p->GetName().ToStdString();
-		auto opts = m_model.groundOptions();
-		const auto old = opts;
-		for (const auto& f : opts.fields())
-		{
-			if (f.key != key) continue;
-			const wxVariant v = p->GetValue();
-			if (auto d = std::get_if<double*>(&f.var)) **d = v.GetDouble();
-			else if (auto fl = std::get_if<float*>(&f.var)) **fl = float(v.GetDouble());
-			else if (auto i = std::get_if<int*>(&f.var)) **i = int(v.GetLong());
-			else if (auto b = std::get_if<bool*>(&f.var)) **b = v.GetBool();
-		}
+		Options opts = m_model.groundOptions();
+		const wxVariant value = p->GetValue();
+		Options::forEachParam(opts, [&](const gam::ParamInfo& info, auto& v) {
+			using T = std::decay_t<decltype(v)>;
+			if (key != info.key) return;
+			if constexpr (std::is_same_v<T, bool>)
+				v = value.GetBool();
+			else if constexpr (std::is_integral_v<T>)
+				v = T(value.GetLong());
+			else
+				v = T(value.GetDouble());
+		});
 		try
 		{
 			wxBusyCursor busy;
-			m_model.applyGroundOptions(opts);	// re-runs the current frame
+			m_model.applyGroundOptions(opts);	// validates, then re-runs the current frame
 		}
 		catch (const std::exception& e)
 		{
 			wxMessageBox(e.what(), "invalid parameter", wxICON_WARNING);
-			m_model.groundOptions() = old;
-			CallAfter([this] { fillProperties(); });
+			CallAfter([this] { fillProperties(); });  // the options in use are unchanged
 		}
 		refreshAll();
 	}
@@ -421,6 +427,7 @@ wxIMPLEMENT_APP_NO_MAIN(ViewerApp);
 int main(int argc, char** argv)
 {
 	mrpt::maps::registerGroundAwareMaps();
+	mrpt::maps::registerBaselineMaps();
 	try
 	{
 		TCLAP::CmdLine cmd("ground-aware-viewer", ' ', "0.1");

@@ -184,9 +184,9 @@ void ViewerModel::seek(int k)
 	k = std::clamp(k, -1, int(m_steps.size()) - 1);
 	if (k < m_current)
 	{
-		const auto opts = m_ga->groundOptions;
+		const auto opts = m_ga->groundOptions();
 		resetMaps();
-		m_ga->groundOptions = opts;
+		m_ga->setGroundOptions(opts);
 	}
 	while (m_current < k) insertStep(size_t(m_current + 1));
 }
@@ -201,10 +201,9 @@ bool ViewerModel::next()
 void ViewerModel::rerunCurrent()
 {
 	if (m_current < 0) return;
-	const auto opts = m_ga->groundOptions;
-	const auto hb = std::make_shared<CHeightBandOccupancyGrid>(*m_hb);
+	const auto opts = m_ga->groundOptions();
 	*m_ga = *m_gaBefore;
-	m_ga->groundOptions = opts;
+	m_ga->setGroundOptions(opts);
 	// only the ground-aware grid depends on the options: keep the others
 	const Step& s = m_steps.at(size_t(m_current));
 	*m_gaBefore = *m_ga;
@@ -219,8 +218,7 @@ void ViewerModel::rerunCurrent()
 
 void ViewerModel::applyGroundOptions(const CGroundAwareOccupancyGrid::TGroundAwareOptions& o)
 {
-	o.validate();
-	m_ga->groundOptions = o;
+	m_ga->setGroundOptions(o);	// validates first: unchanged if it throws
 	rerunCurrent();
 }
 
@@ -299,9 +297,9 @@ std::string ViewerModel::statusText() const
 		o << "voxels: ground " << d.ism.ground << ", obstacle " << d.ism.obstacle << ", drop "
 		  << d.ism.drop << ", overhead " << d.ism.overhead << ", out of range " << d.ism.out_of_range
 		  << ", drop-ray cells " << d.ism.drop_ray_cells << "; points " << d.points << "\n";
-		o << "stages [ms]: projection " << d.ms_projection << ", outliers " << d.ms_outliers
-		  << ", ground " << d.ms_ground << ", ism " << d.ms_ism << ", update " << d.ms_update
-		  << ", total " << d.ms_total << "\n";
+		o << "stages [ms]: projection " << d.ms.projection << ", outliers " << d.ms.outliers << ", ground "
+		  << d.ms.ground << ", ism " << d.ms.ism << ", update " << m_ga->lastFrameTimes().update << ", total "
+		  << m_ga->lastFrameTimes().total << "\n";
 	}
 	else
 		o << "(no 3D scan in this step)\n";
@@ -508,7 +506,7 @@ void addFrame3D(const ViewerModel& m, COpenGLScene& scene)
 				x0 = std::min<double>(x0, n.x), x1 = std::max<double>(x1, n.x),
 				y0 = std::min<double>(y0, n.y), y1 = std::max<double>(y1, n.y);
 		if (x1 < x0) continue;
-		const double mg = k == 0 ? 0.5 : ga.groundOptions.plane_support_radius;
+		const double mg = k == 0 ? 0.5 : ga.groundOptions().pipeline.ism.plane_support_radius;
 		x0 -= mg, x1 += mg, y0 -= mg, y1 += mg;
 		auto patch = CSetOfTriangles::Create();
 		auto P = [&](double x, double y) {

@@ -73,10 +73,10 @@ class ViewerModel
 	 * inserts the step again (with the current groundOptions). */
 	void rerunCurrent();
 
-	/** The ground-aware options; after editing them call applyGroundOptions(). */
-	mrpt::maps::CGroundAwareOccupancyGrid::TGroundAwareOptions& groundOptions()
+	/** The ground-aware options in use; to change them, edit a copy and call applyGroundOptions(). */
+	const mrpt::maps::CGroundAwareOccupancyGrid::TGroundAwareOptions& groundOptions() const
 	{
-		return m_ga->groundOptions;
+		return m_ga->groundOptions();
 	}
 	/** Validates (throws std::invalid_argument, options unchanged then) and re-runs the current step. */
 	void applyGroundOptions(const mrpt::maps::CGroundAwareOccupancyGrid::TGroundAwareOptions& o);

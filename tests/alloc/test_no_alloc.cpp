@@ -27,9 +27,8 @@
 
 #include "../maps/real_data.h"
 #include "../maps/synthetic_scene.h"
-#include "gam/ElevationGrid.h"
-#include "gam/InverseSensorModel.h"
-#include "gam/RrtGroundDetector.h"
+#include "gam/core/ElevationGrid.h"
+#include "gam/core/GroundAwarePipeline.h"
 
 // ---------------------------------------------------------------------------
 // Counting allocator.
@@ -277,58 +276,48 @@ TEST(NoAlloc, GroundAwareGridRealAndSyntheticFramesSteadyState)
 	EXPECT_EQ(worst, 0u) << "heap allocations per frame after warm-up; run with GAM_ALLOC_TRACE=1 to see where";
 }
 
-// The pure core pipeline (no MRPT): 2.5D map, RRT-GPD, ISM.
+// The pure core pipeline (no MRPT): gam::GroundAwarePipeline, the object the
+// map runs: 2.5D map, 3-sigma filter, IDW, RRT-GPD, ISM.
 TEST(NoAlloc, CorePipelineSteadyState)
 {
-	gam::GridGeometry geom;
-	geom.resolution = 0.05;
-	geom.nx = geom.ny = 200;
-	gam::ElevationGrid grid(geom);
-	gam::BinnedPoints bins;
-	gam::RrtGroundDetector rrt;
-	gam::InverseSensorModel ism;
-	gam::GroundDetection det;
-	gam::IsmStats stats;
-	gam::OutlierFilterParams of;
-	gam::IdwParams idw;
-	idw.radius_cells = 1;
+	gam::GroundAwarePipeline pipeline;	// m_x = m_y = 200 at 5 cm, IDW radius 1
 
-	// A noisy floor with a 15 cm box and a gentle ramp, in a fixed point set.
+	// A noisy floor with a 15 cm box and a gentle ramp, in a fixed point set
+	// (map frame: the sensor transform is the identity).
 	std::mt19937 rng(7);
 	std::normal_distribution<float> noise(0.f, 0.004f);
 	std::uniform_real_distribution<double> U(0.0, 1.0);
-	std::vector<std::array<float, 3>> pts;
+	std::vector<float> xs, ys, zs;
 	for (int i = 0; i < 60000; i++)
 	{
 		const double x = 0.3 + 3.5 * U(rng), y = -2.0 + 4.0 * U(rng);
 		float z = noise(rng);
 		if (x > 1.5 && x < 1.8 && y > 0.3 && y < 0.6) z += 0.15f;
 		if (x > 2.5 && y < -0.5) z += float(0.1 * (x - 2.5));	// ~5.7 deg ramp
-		pts.push_back({float(x), float(y), z});
+		xs.push_back(float(x));
+		ys.push_back(float(y));
+		zs.push_back(z);
 	}
+	gam::SensorFrame frame;
+	frame.x = xs.data();
+	frame.y = ys.data();
+	frame.z = zs.data();
+	frame.point_count = xs.size();
 
 	size_t worst = 0;
 	for (int k = 0; k < kWarmUp + kMeasured; k++)
 	{
-		const double rx = 0.01 * k;	 // robot moves 1 cm per frame
-		gam::GroundSeedHint hint;
-		hint.x = rx;
+		const double rx = 0.01 * k;	 // robot moves 1 cm per frame: the frame grid recentres
+		frame.sensor_position = Eigen::Vector3d(rx, 0, 1.0);
 		size_t n;
+		const gam::FrameResult* r;
 		{
 			AllocCounter count;
-			grid.recenter(
-				std::round((rx - 0.5 * geom.nx * geom.resolution) / geom.resolution) * geom.resolution,
-				-0.5 * geom.ny * geom.resolution);
-			bins.clear();
-			for (const auto& p : pts) grid.binPoint(p[0], p[1], p[2], bins);
-			grid.insert(bins, of);
-			grid.interpolateIdw(idw);
-			rrt.detect(grid, hint, det);
-			ism.compute(grid, det, Eigen::Vector3d(rx, 0, 1.0), stats);
+			r = &pipeline.process(frame, Eigen::Vector3d(rx, 0, 0), gam::GridLattice{0, 0, 0.05});
 			n = count.count();
 		}
-		ASSERT_TRUE(det.ok()) << det.describe();
-		ASSERT_TRUE(stats.applied);
+		ASSERT_TRUE(r->detection.ok()) << r->detection.describe();
+		ASSERT_TRUE(r->ism.applied);
 		if (k >= kWarmUp) worst = std::max(worst, n);
 		else if (k == 0) std::cout << "[alloc] core: first frame " << n << " allocations\n";
 	}

@@ -9,10 +9,10 @@
 // frames, and the ratios; then the ground-aware grid's stages (median / p95);
 // with --full-octomap=M, also the octomap fed every pixel (first M frames).
 #include <benchmark/benchmark.h>
+#include <gam/maps/ObservationAdapters.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
 #include <mrpt/maps/COctoMapGrid2D.h>
-#include <mrpt/maps/gam_observation_adapters.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
@@ -78,111 +78,28 @@ Dataset load(const std::string& file, size_t maxFrames)
 std::vector<Dataset> g_data;
 
 // --- stage cases -------------------------------------------------------------
-void BM_Projection(benchmark::State& st, const Dataset* d)
+// Each stage as it runs inside the real pipeline (gam::GroundAwarePipeline, the
+// object CGroundAwareOccupancyGrid runs): every iteration processes the next
+// frame and reports that stage's own timer (manual time).
+void BM_Stage(benchmark::State& st, const Dataset* d, double gam::StageTimes::*stage)
 {
-	CGroundAwareOccupancyGrid grid;
-	gam::ElevationGrid frame;
-	gam::GridGeometry geo;
-	geo.nx = grid.groundOptions.m_x;
-	geo.ny = grid.groundOptions.m_y;
-	frame.resize(geo);
-	gam::DepthProjector proj;
-	gam::BinnedPoints bins;
-	gam::mrpt_glue::BinningOptions bo;
-	size_t i = 0, samples = 0, n = 0;
+	const CGroundAwareOccupancyGrid grid;  // its default options and cell lattice
+	gam::GroundAwarePipeline pipeline(grid.groundOptions().pipeline);
+	const gam::GridLattice lattice{grid.getXMin(), grid.getYMin(), grid.getResolution()};
+	size_t i = 0, samples = 0, ok = 0, n = 0;
 	for (auto _ : st)
 	{
 		const Frame& f = d->frames[i++ % d->frames.size()];
-		bo.filter = grid.groundOptions.projectionFilter(f.pose.z());
-		frame.recenter(f.pose.x() - 5, f.pose.y() - 5);
-		bins.clear();
-		gam::mrpt_glue::binObservation(*f.depth, f.pose, bo, frame, proj, bins);
-		benchmark::DoNotOptimize(bins.size());
-		samples += bins.size();
+		gam::SensorFrame frame;
+		gam::maps::toSensorFrame(*f.depth, f.pose, frame);
+		const gam::FrameResult& r = pipeline.process(frame, Eigen::Vector3d(f.pose.x(), f.pose.y(), f.pose.z()), lattice);
+		st.SetIterationTime(r.ms.*stage / 1000.0);
+		samples += r.samples;
+		ok += r.detection.ok();
 		n++;
 	}
-	st.counters["samples/frame"] = n ? double(samples) / double(n) : 0;
-}
-
-void BM_OutlierFilter(benchmark::State& st, const Dataset* d)
-{
-	CGroundAwareOccupancyGrid grid;
-	gam::GridGeometry geo;
-	geo.nx = grid.groundOptions.m_x;
-	geo.ny = grid.groundOptions.m_y;
-	std::vector<std::pair<gam::BinnedPoints, gam::GridGeometry>> pre;
-	gam::ElevationGrid frame(geo);
-	gam::DepthProjector proj;
-	gam::mrpt_glue::BinningOptions bo;
-	for (const Frame& f : d->frames)
-	{
-		gam::BinnedPoints b;
-		bo.filter = grid.groundOptions.projectionFilter(f.pose.z());
-		frame.recenter(f.pose.x() - 5, f.pose.y() - 5);
-		gam::mrpt_glue::binObservation(*f.depth, f.pose, bo, frame, proj, b);
-		pre.emplace_back(std::move(b), frame.geometry());
-	}
-	size_t i = 0;
-	for (auto _ : st)
-	{
-		const auto& [b, g] = pre[i++ % pre.size()];
-		frame.recenter(g.x_min, g.y_min);
-		benchmark::DoNotOptimize(frame.insert(b, grid.groundOptions.outlierParams()));
-	}
-}
-
-// Frames already in 2.5D (projection + filter + IDW done), for RRT-GPD and ISM.
-struct Prepared
-{
-	std::vector<gam::ElevationGrid> grids;
-	std::vector<gam::GroundDetection> dets;
-	std::vector<Eigen::Vector3d> sensors;
-};
-Prepared prepare(const Dataset* d)
-{
-	Prepared p;
-	for (const Frame& f : d->frames)
-	{
-		CGroundAwareOccupancyGrid g;
-		g.insertObservation(*f.depth, f.pose);
-		p.grids.push_back(g.lastFrameElevation());
-		p.dets.push_back(g.lastFrame().detection);
-		p.sensors.push_back(g.lastFrame().sensor);
-	}
-	return p;
-}
-
-void BM_RrtGpd(benchmark::State& st, const Dataset* d)
-{
-	const Prepared p = prepare(d);
-	CGroundAwareOccupancyGrid grid;
-	gam::RrtGroundDetector det(grid.groundOptions.rrtParams());
-	gam::GroundDetection out;
-	size_t i = 0, ok = 0, n = 0;
-	for (auto _ : st)
-	{
-		const size_t k = i++ % p.grids.size();
-		const Frame& f = d->frames[k];
-		det.detect(p.grids[k], {f.pose.x(), f.pose.y(), f.pose.z()}, out);
-		ok += out.ok();
-		n++;
-	}
-	st.counters["ground_found_%"] = n ? 100.0 * double(ok) / double(n) : 0;
-}
-
-void BM_Ism(benchmark::State& st, const Dataset* d)
-{
-	const Prepared p = prepare(d);
-	CGroundAwareOccupancyGrid grid;
-	gam::InverseSensorModel ism(grid.groundOptions.ismParams());
-	gam::IsmStats s;
-	size_t i = 0;
-	for (auto _ : st)
-	{
-		const size_t k = i++ % p.grids.size();
-		ism.compute(p.grids[k], p.dets[k], p.sensors[k], s);
-		benchmark::DoNotOptimize(ism.evidenceCells().size());
-	}
+	if (stage == &gam::StageTimes::projection) st.counters["samples/frame"] = n ? double(samples) / double(n) : 0;
+	if (stage == &gam::StageTimes::ground) st.counters["ground_found_%"] = n ? 100.0 * double(ok) / double(n) : 0;
 }
 
 void BM_LeddarInsertion(benchmark::State& st, const Dataset* d)
@@ -246,18 +163,18 @@ double quantile(std::vector<double> v, double q)
 }
 
 // The ground-aware grid's own per-stage timings (lastFrame()), frame by frame.
-struct StageTimes
+struct StageSeries
 {
 	std::vector<double> projection, outliers, ground, ism, update, total;
 	void add(const CGroundAwareOccupancyGrid& grid)
 	{
-		const auto& l = grid.lastFrame();
-		projection.push_back(l.ms_projection);
-		outliers.push_back(l.ms_outliers);
-		ground.push_back(l.ms_ground);
-		ism.push_back(l.ms_ism);
-		update.push_back(l.ms_update);
-		total.push_back(l.ms_total);
+		const gam::StageTimes& l = grid.lastFrame().ms;
+		projection.push_back(l.projection);
+		outliers.push_back(l.outliers);
+		ground.push_back(l.ground);
+		ism.push_back(l.ism);
+		update.push_back(grid.lastFrameTimes().update);
+		total.push_back(grid.lastFrameTimes().total);
 	}
 };
 
@@ -299,10 +216,15 @@ int main(int argc, char** argv)
 	for (const Dataset& d : g_data)
 	{
 		const std::string n = d.name + "/";
-		benchmark::RegisterBenchmark((n + "1_projection").c_str(), BM_Projection, &d)->Unit(benchmark::kMillisecond);
-		benchmark::RegisterBenchmark((n + "2_outlier_filter").c_str(), BM_OutlierFilter, &d)->Unit(benchmark::kMillisecond);
-		benchmark::RegisterBenchmark((n + "3_rrt_gpd").c_str(), BM_RrtGpd, &d)->Unit(benchmark::kMillisecond);
-		benchmark::RegisterBenchmark((n + "4_ism").c_str(), BM_Ism, &d)->Unit(benchmark::kMillisecond);
+		const std::pair<const char*, double gam::StageTimes::*> stageCases[] = {
+			{"1_projection", &gam::StageTimes::projection},
+			{"2_outlier_filter", &gam::StageTimes::outliers},
+			{"3_rrt_gpd", &gam::StageTimes::ground},
+			{"4_ism", &gam::StageTimes::ism}};
+		for (const auto& [name, stage] : stageCases)
+			benchmark::RegisterBenchmark((n + name).c_str(), BM_Stage, &d, stage)
+				->UseManualTime()
+				->Unit(benchmark::kMillisecond);
 		benchmark::RegisterBenchmark((n + "5_leddar").c_str(), BM_LeddarInsertion, &d)->Unit(benchmark::kMillisecond);
 		benchmark::RegisterBenchmark((n + "6_whole_pipeline").c_str(), BM_WholeMap<CGroundAwareOccupancyGrid>, &d)
 			->Unit(benchmark::kMillisecond);
@@ -313,7 +235,7 @@ int main(int argc, char** argv)
 	benchmark::Shutdown();
 
 	// Each map once over the same frames; the ground-aware run also records its stages.
-	std::vector<StageTimes> stages(g_data.size());
+	std::vector<StageSeries> stages(g_data.size());
 	std::vector<double> groundAwareMedian(g_data.size());
 	std::printf("\n| data | frames | px/frame | ground_aware median / p95 ms | height_band median / p95 ms | octomap median / p95 ms | height_band / ground_aware | octomap / ground_aware |\n|---|---|---|---|---|---|---|---|\n");
 	for (size_t k = 0; k < g_data.size(); k++)
@@ -339,7 +261,7 @@ int main(int argc, char** argv)
 	};
 	for (size_t k = 0; k < g_data.size(); k++)
 	{
-		const StageTimes& t = stages[k];
+		const StageSeries& t = stages[k];
 		std::printf("| %s | %s | %s | %s | %s | %s | %s |\n", g_data[k].name.c_str(), mp(t.projection).c_str(),
 					mp(t.outliers).c_str(), mp(t.ground).c_str(), mp(t.ism).c_str(), mp(t.update).c_str(),
 					mp(t.total).c_str());

@@ -1,4 +1,4 @@
-// Tests of libs/evaluation (gam::eval) and rawlog_tools/gam-evaluate on hand-made
+// Tests of libs/ground_eval (gam::eval) and rawlog_tools/gam-evaluate on hand-made
 // ground truth and hand-made maps written into a temporary folder.
 #include <gtest/gtest.h>
 #include <sys/wait.h>

@@ -5,6 +5,7 @@
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
 #include <mrpt/maps/COctoMapGrid2D.h>
+#include <mrpt/maps/registerBaselineMaps.h>
 #include <mrpt/maps/registerGroundAwareMaps.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
@@ -45,9 +46,12 @@ inline mrpt::obs::CObservation3DRangeScan::Ptr tinyFrame()
 inline std::vector<std::shared_ptr<mrpt::maps::CMetricMap>> freshMaps()
 {
 	mrpt::maps::registerGroundAwareMaps();
+	mrpt::maps::registerBaselineMaps();
 	auto ga = std::make_shared<mrpt::maps::CGroundAwareOccupancyGrid>(-2, 2, -2, 2, 0.05);
-	ga->groundOptions.m_x = ga->groundOptions.m_y = 100;
-	ga->groundOptions.K = 100;
+	auto o = ga->groundOptions();
+	o.pipeline.m_x = o.pipeline.m_y = 100;
+	o.pipeline.rrt.iterations = 100;
+	ga->setGroundOptions(o);
 	return {
 		std::make_shared<mrpt::maps::CElevation25DMap>(-5, 5, -5, 5, 0.1), ga,
 		std::make_shared<mrpt::maps::CHeightBandOccupancyGrid>(-2, 2, -2, 2, 0.05),

@@ -49,7 +49,7 @@ bool bounded(const TSetOfMetricMapInitializers& inits)
 		}
 		else if (const auto* e = dynamic_cast<const CElevation25DMap::TMapDefinition*>(i.get()))
 		{
-			if (!small(e->min_x, e->max_x, e->min_y, e->max_y, e->resolution) || e->insertionOpts.idw_radius > 5)
+			if (!small(e->min_x, e->max_x, e->min_y, e->max_y, e->resolution) || e->insertionOpts.idw.radius_cells > 5)
 				return false;
 		}
 		else

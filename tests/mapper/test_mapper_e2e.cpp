@@ -1,12 +1,13 @@
 // End-to-end tests of ground-aware-mapper: run the real executable on a real
 // rawlog and on generated ones (both rawlog formats), and check every output.
 #include <gam/eval/Evaluation.h>
-#include <gam/mapper/GridIO.h>
+#include <gam/maps/GridIO.h>
 #include <gtest/gtest.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/CElevation25DMap.h>
+#include <mrpt/maps/registerBaselineMaps.h>
 #include <mrpt/maps/registerGroundAwareMaps.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
@@ -29,7 +30,7 @@
 
 namespace fs = std::filesystem;
 using mrpt::maps::COccupancyGridMap2D;
-using namespace gam::mapper;
+using namespace gam::maps;
 
 namespace
 {
@@ -221,7 +222,7 @@ void checkOutputs(const std::string& dir)
 		const std::string base = dir + "/" + name;
 		for (const char* ext : {".yaml", ".pgm", ".gridmap.gz", ".png"})
 			ASSERT_TRUE(fs::exists(base + ext)) << base + ext;
-		// The evaluator's map_server reader (libs/evaluation), not the writer's code.
+		// The evaluator's map_server reader (libs/ground_eval), not the writer's code.
 		const gam::eval::RosMap y = gam::eval::loadRosMap(base + ".yaml");
 		const COccupancyGridMap2D g = readGridmapGz(base + ".gridmap.gz");
 		EXPECT_EQ(fs::path(y.imagePath).filename().string(), name + ".pgm");
@@ -279,6 +280,7 @@ void checkOutputs(const std::string& dir)
 		EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
 	{
 		mrpt::maps::registerGroundAwareMaps();
+		mrpt::maps::registerBaselineMaps();
 		mrpt::io::CFileGZInputStream fi(dir + "/elevation.map.gz");
 		mrpt::maps::CElevation25DMap em;
 		mrpt::serialization::archiveFrom(fi) >> em;

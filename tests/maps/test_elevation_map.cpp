@@ -74,8 +74,11 @@ TEST(ElevationMap, OutlierFilterAndIdwOptions)
 	pts.insertPoint(0.02f, 0.02f, 0.5f);
 	pts.insertPoint(0.22f, 0.02f, 0.2f);  // a second cell, 0.2 m from the first
 	CElevation25DMap on(-1, 1, -1, 1, 0.1), off(-1, 1, -1, 1, 0.1);
-	off.insertionOptions.outlier_filter = false;
-	on.insertionOptions.idw_radius = 2;
+	auto offOpts = off.insertionOptions(), onOpts = on.insertionOptions();
+	offOpts.outliers.enabled = false;
+	onOpts.idw.radius_cells = 2;
+	off.setInsertionOptions(offOpts);
+	on.setInsertionOptions(onOpts);
 	on.insertPointCloud(pts);
 	off.insertPointCloud(pts);
 	const auto& g = on.grid().geometry();
@@ -89,7 +92,8 @@ TEST(ElevationMap, OutlierFilterAndIdwOptions)
 	EXPECT_EQ(mid.count, 0u);
 	// min_neighbours = 3 by default: two observed cells are not enough.
 	EXPECT_TRUE(std::isnan(mid.z_idw));
-	on.insertionOptions.idw_min_neighbours = 2;
+	onOpts.idw.min_neighbours = 2;
+	on.setInsertionOptions(onOpts);
 	on.insertPointCloud(CSimplePointsMap());  // re-runs IDW
 	EXPECT_NEAR(on.grid().cell(g.ix(0.12), g.iy(0.02)).z_idw, 0.1, 1e-5);
 }

@@ -75,7 +75,9 @@ TEST(GroundAwareGrid, RampStaysFreeWithLocalPlanesOnly)
 	s.push_back({4.0, -1.0, -0.1, 6.0, 1.0, 1.5 * slope});
 
 	CGroundAwareOccupancyGrid local, global;
-	global.groundOptions.local_planes = false;
+	auto globalOnly = global.groundOptions();
+	globalOnly.pipeline.ism.local_planes = false;
+	global.setGroundOptions(globalOnly);
 	auto obs = testscene::renderDepth(s, kKinect);
 	local.insertObservation(*obs);
 	global.insertObservation(*obs);
@@ -102,7 +104,9 @@ TEST(GroundAwareGrid, OverheadBeamDoesNotBlockButATableDoes)
 						  {2.5, -1.5, 1.1, 3.5, -0.5, 1.2},	 // beam
 						  {2.5, 0.5, 0.68, 3.5, 1.5, 0.72}};	 // table top
 	CGroundAwareOccupancyGrid g;
-	g.groundOptions.robot_height = 1.0;
+	auto o = g.groundOptions();
+	o.pipeline.ism.robot_height = 1.0;
+	g.setGroundOptions(o);
 	g.insertObservation(*testscene::renderDepth(s, CPose3D(0, 0, 0.9, 0, DEG2RAD(15.0), 0), {}, 512, 424));
 	ASSERT_TRUE(g.lastFrame().detection.ok());
 	int beamFree = 0, tableOcc = 0, n = 0;
@@ -173,7 +177,9 @@ TEST(GroundAwareGrid, LeddarScanFusesThroughTheBeamModel)
 		s.setScanRangeValidity(i, true);
 	}
 	CGroundAwareOccupancyGrid g, plain;
-	plain.groundOptions.scan_keeps_3d_obstacles = false;
+	auto beamModel = plain.groundOptions();
+	beamModel.scan_keeps_3d_obstacles = false;
+	plain.setGroundOptions(beamModel);
 	ASSERT_TRUE(g.insertObservation(s));
 	ASSERT_TRUE(plain.insertObservation(s));
 	for (const auto* m : {&g, &plain})
@@ -206,7 +212,9 @@ TEST(GroundAwareGrid, LeddarBeamsOverAHoleDoNotClearIt)
 	for (bool keep : {true, false})
 	{
 		CGroundAwareOccupancyGrid g;
-		g.groundOptions.scan_keeps_3d_obstacles = keep;
+		auto o = g.groundOptions();
+		o.scan_keeps_3d_obstacles = keep;
+		g.setGroundOptions(o);
 		g.insertObservation(*testscene::renderDepth(scene, kKinect));
 		const double hole = pOcc(g, 2.2, 0.0), box = pOcc(g, 1.6, 0.7), floor = pOcc(g, 1.0, 0.0);
 		ASSERT_GT(hole, 0.7);

@@ -79,10 +79,12 @@ TEST(RealData, ElevationMapMatchesMrptUnprojection)
 	CElevation25DMap direct(-5, 5, -5, 5, 0.05), viaMrpt(-5, 5, -5, 5, 0.05);
 	for (auto* m : {&direct, &viaMrpt})
 	{
-		m->insertionOptions.outlier_filter = false;
-		m->insertionOptions.max_range = 100;
-		m->insertionOptions.z_min = -10;
-		m->insertionOptions.z_max = 10;
+		auto opts = m->insertionOptions();
+		opts.outliers.enabled = false;
+		opts.projection.max_range = 100;
+		opts.projection.z_min = -10;
+		opts.projection.z_max = 10;
+		m->setInsertionOptions(opts);
 	}
 	auto oc = *o;
 	oc.hasPoints3D = false;	 // force the range-image path

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
+#include <gam/maps/IniFields.h>
 #include <mrpt/maps/CElevation25DMap.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/maps/CMultiMetricMap.h>
@@ -71,15 +72,16 @@ outlier_filter=false
 	EXPECT_NEAR(ga->getResolution(), 0.1, 1e-6);
 	EXPECT_NEAR(ga->getXMin(), -4, 1e-4);
 	EXPECT_NEAR(ga->getXMax(), 6, 1e-4);
-	EXPECT_EQ(ga->groundOptions.K, 300);
-	EXPECT_DOUBLE_EQ(ga->groundOptions.N_th, 0.15);
-	EXPECT_DOUBLE_EQ(ga->groundOptions.d_pth, 0.04);
-	EXPECT_FALSE(ga->groundOptions.local_planes);
-	EXPECT_EQ(ga->groundOptions.s_x, 3);  // untouched keys keep Table I defaults
+	const gam::PipelineParams& p = ga->groundOptions().pipeline;
+	EXPECT_EQ(p.rrt.iterations, 300);
+	EXPECT_DOUBLE_EQ(p.rrt.normal_threshold, 0.15);
+	EXPECT_DOUBLE_EQ(p.ism.d_pth, 0.04);
+	EXPECT_FALSE(p.ism.local_planes);
+	EXPECT_EQ(p.rrt.neighbourhood_x, 3);  // untouched keys keep Table I defaults
 	EXPECT_EQ(el->grid().geometry().nx, 100);
 	EXPECT_DOUBLE_EQ(el->grid().geometry().resolution, 0.02);
-	EXPECT_EQ(el->insertionOptions.idw_radius, 2);
-	EXPECT_FALSE(el->insertionOptions.outlier_filter);
+	EXPECT_EQ(el->insertionOptions().idw.radius_cells, 2);
+	EXPECT_FALSE(el->insertionOptions().outliers.enabled);
 	// The derived grid is also found as a COccupancyGridMap2D (MRPT tools rely on it).
 	EXPECT_EQ(mm.countMapsByClass<COccupancyGridMap2D>(), 2u);
 }
@@ -96,22 +98,22 @@ TEST(IniConstruction, LeddarNoReturnIsNotFreeSpaceFromIniEither)
 TEST(IniConstruction, DefaultsAreThePaperTableI)
 {
 	CGroundAwareOccupancyGrid g;
-	const auto& o = g.groundOptions;
-	EXPECT_EQ(o.K, 600);
-	EXPECT_DOUBLE_EQ(o.N_th, 0.2);
-	EXPECT_DOUBLE_EQ(o.E_th, 0.05);
-	EXPECT_EQ(o.s_x, 3);
-	EXPECT_EQ(o.s_y, 3);
+	const gam::PipelineParams& o = g.groundOptions().pipeline;
+	EXPECT_EQ(o.rrt.iterations, 600);  // K
+	EXPECT_DOUBLE_EQ(o.rrt.normal_threshold, 0.2);	// N_th
+	EXPECT_DOUBLE_EQ(o.rrt.elevation_threshold, 0.05);	// E_th
+	EXPECT_EQ(o.rrt.neighbourhood_x, 3);  // s_x
+	EXPECT_EQ(o.rrt.neighbourhood_y, 3);  // s_y
 	EXPECT_EQ(o.m_x, 200);
 	EXPECT_EQ(o.m_y, 200);
 	EXPECT_NEAR(g.getResolution(), 0.05, 1e-7);	 // d_r
-	EXPECT_DOUBLE_EQ(o.d_n, 0.4);
-	EXPECT_DOUBLE_EQ(o.d_pth, 0.03);
-	EXPECT_DOUBLE_EQ(o.K_g, 0.3);
-	EXPECT_DOUBLE_EQ(o.sigma2, 0.02);
-	EXPECT_DOUBLE_EQ(o.K_n, 0.0005);
-	EXPECT_DOUBLE_EQ(o.d_min, 3);
-	EXPECT_DOUBLE_EQ(o.K_m, 0.8);
+	EXPECT_DOUBLE_EQ(o.rrt.expansion_distance, 0.4);  // d_n
+	EXPECT_DOUBLE_EQ(o.ism.d_pth, 0.03);
+	EXPECT_DOUBLE_EQ(o.ism.K_g, 0.3);
+	EXPECT_DOUBLE_EQ(o.ism.sigma2, 0.02);
+	EXPECT_DOUBLE_EQ(o.ism.K_n, 0.0005);
+	EXPECT_DOUBLE_EQ(o.ism.d_min, 3);
+	EXPECT_DOUBLE_EQ(o.ism.K_m, 0.8);
 }
 
 TEST(IniConstruction, ExampleConfigLoadsWithTableIValues)
@@ -124,17 +126,21 @@ TEST(IniConstruction, ExampleConfigLoadsWithTableIValues)
 	ASSERT_TRUE(ga);
 	CGroundAwareOccupancyGrid ref;
 	// Every key of the example is spelled right and holds the default.
-	auto f = ga->groundOptions.fields();
-	auto fr = ref.groundOptions.fields();
-	ASSERT_EQ(f.size(), fr.size());
-	for (size_t i = 0; i < f.size(); i++)
-	{
-		EXPECT_TRUE(cfg.keyExists("map_groundAwareGrid_00_groundOpts", f[i].key)) << f[i].key << " missing in the example";
-		const double a = std::visit([](auto* p) { return double(*p); }, f[i].var);
-		const double b = std::visit([](auto* p) { return double(*p); }, fr[i].var);
-		EXPECT_DOUBLE_EQ(a, b) << f[i].key;
-	}
-	EXPECT_TRUE(gam::ini::unknownKeys(f, cfg, "map_groundAwareGrid_00_groundOpts").empty());
+	using Options = CGroundAwareOccupancyGrid::TGroundAwareOptions;
+	const std::string sec = "map_groundAwareGrid_00_groundOpts";
+	std::vector<double> loaded, defaults;
+	Options::forEachParam(ga->groundOptions(), [&](const gam::ParamInfo& info, const auto& v) {
+		EXPECT_TRUE(cfg.keyExists(sec, info.key)) << info.key << " missing in the example";
+		loaded.push_back(double(v));
+	});
+	Options::forEachParam(ref.groundOptions(), [&](const gam::ParamInfo&, const auto& v) { defaults.push_back(double(v)); });
+	ASSERT_EQ(loaded.size(), defaults.size());
+	for (size_t i = 0; i < loaded.size(); i++) EXPECT_DOUBLE_EQ(loaded[i], defaults[i]) << "key #" << i;
+	// ... and it has no key the options do not know.
+	std::vector<std::string> keys;
+	cfg.getAllKeys(sec, keys);
+	const auto known = gam::maps::ini::keys<Options>();
+	for (const auto& k : keys) EXPECT_NE(std::find(known.begin(), known.end(), k), known.end()) << k;
 }
 
 TEST(IniConstruction, OutOfRangeValuesNameTheKey)
@@ -174,14 +180,16 @@ TEST(IniConstruction, OutOfRangeValuesNameTheKey)
 TEST(IniConstruction, SaveThenLoadGivesTheSameOptions)
 {
 	CGroundAwareOccupancyGrid a;
-	a.groundOptions.K = 123;
-	a.groundOptions.d_pth = 0.045;
-	a.groundOptions.drop_rays = false;
+	auto o = a.groundOptions();
+	o.pipeline.rrt.iterations = 123;
+	o.pipeline.ism.d_pth = 0.045;
+	o.pipeline.ism.drop_rays = false;
+	a.setGroundOptions(o);
 	mrpt::config::CConfigFileMemory mem;
-	a.groundOptions.saveToConfigFile(mem, "g");
-	CGroundAwareOccupancyGrid b;
-	b.groundOptions.loadFromConfigFile(mem, "g");
-	EXPECT_EQ(b.groundOptions.K, 123);
-	EXPECT_DOUBLE_EQ(b.groundOptions.d_pth, 0.045);
-	EXPECT_FALSE(b.groundOptions.drop_rays);
+	a.groundOptions().saveToConfigFile(mem, "g");
+	CGroundAwareOccupancyGrid::TGroundAwareOptions b;
+	b.loadFromConfigFile(mem, "g");
+	EXPECT_EQ(b.pipeline.rrt.iterations, 123);
+	EXPECT_DOUBLE_EQ(b.pipeline.ism.d_pth, 0.045);
+	EXPECT_FALSE(b.pipeline.ism.drop_rays);
 }

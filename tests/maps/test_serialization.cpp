@@ -34,13 +34,15 @@ typename T::Ptr roundTrip(const T& m)
 TEST(Serialization, ElevationMapRoundTrip)
 {
 	CElevation25DMap m(-2, 6, -3, 3, 0.05);
-	m.insertionOptions.idw_radius = 1;
+	auto mo = m.insertionOptions();
+	mo.idw.radius_cells = 1;
+	m.setInsertionOptions(mo);
 	m.insertObservation(*testscene::renderDepth(boxScene(), kKinect));
 	ASSERT_FALSE(m.isEmpty());
 	auto r = roundTrip(m);
 	ASSERT_TRUE(r);
 	ASSERT_TRUE(r->grid().geometry() == m.grid().geometry());
-	EXPECT_EQ(r->insertionOptions.idw_radius, 1);
+	EXPECT_EQ(r->insertionOptions().idw.radius_cells, 1);
 	ASSERT_EQ(r->grid().observedCount(), m.grid().observedCount());
 	for (uint32_t i : m.grid().observedCells())
 	{
@@ -55,13 +57,15 @@ TEST(Serialization, ElevationMapRoundTrip)
 TEST(Serialization, GroundAwareGridRoundTripKeepsCellsAndOptions)
 {
 	CGroundAwareOccupancyGrid g(-2, 6, -4, 4, 0.05);
-	g.groundOptions.K = 321;
-	g.groundOptions.local_planes = false;
+	auto go = g.groundOptions();
+	go.pipeline.rrt.iterations = 321;
+	go.pipeline.ism.local_planes = false;
+	g.setGroundOptions(go);
 	g.insertObservation(*testscene::renderDepth(boxScene(), kKinect));
 	auto r = roundTrip(g);
 	ASSERT_TRUE(r);
-	EXPECT_EQ(r->groundOptions.K, 321);
-	EXPECT_FALSE(r->groundOptions.local_planes);
+	EXPECT_EQ(r->groundOptions().pipeline.rrt.iterations, 321);
+	EXPECT_FALSE(r->groundOptions().pipeline.ism.local_planes);
 	ASSERT_EQ(r->getSizeX(), g.getSizeX());
 	ASSERT_EQ(r->getSizeY(), g.getSizeY());
 	EXPECT_EQ(r->getRawMap(), g.getRawMap());
@@ -71,7 +75,7 @@ TEST(Serialization, MultiMetricMapCopyClonesBothMaps)
 {
 	TSetOfMetricMapInitializers inits;
 	CGroundAwareOccupancyGrid::TMapDefinition d1;
-	d1.groundOpts.K = 250;
+	d1.groundOpts.pipeline.rrt.iterations = 250;
 	inits.push_back(d1);
 	CElevation25DMap::TMapDefinition d2;
 	inits.push_back(d2);
@@ -81,7 +85,7 @@ TEST(Serialization, MultiMetricMapCopyClonesBothMaps)
 	ASSERT_EQ(b.maps.size(), 2u);
 	auto ga = a.mapByClass<CGroundAwareOccupancyGrid>(), gb = b.mapByClass<CGroundAwareOccupancyGrid>();
 	ASSERT_TRUE(gb);
-	EXPECT_EQ(gb->groundOptions.K, 250);
+	EXPECT_EQ(gb->groundOptions().pipeline.rrt.iterations, 250);
 	EXPECT_EQ(ga->getRawMap(), gb->getRawMap());
 	EXPECT_EQ(a.mapByClass<CElevation25DMap>()->grid().observedCount(),
 			  b.mapByClass<CElevation25DMap>()->grid().observedCount());

@@ -7,6 +7,7 @@
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
 #include <mrpt/maps/COctoMapGrid2D.h>
+#include <mrpt/maps/registerBaselineMaps.h>
 #include <mrpt/maps/registerGroundAwareMaps.h>
 
 #include <functional>
@@ -28,6 +29,7 @@ struct NamedMap
 inline std::vector<NamedMap> allMaps()
 {
 	mrpt::maps::registerGroundAwareMaps();
+	mrpt::maps::registerBaselineMaps();
 	return {
 		{"CElevation25DMap", std::make_shared<mrpt::maps::CElevation25DMap>()},
 		{"CGroundAwareOccupancyGrid", std::make_shared<mrpt::maps::CGroundAwareOccupancyGrid>()},

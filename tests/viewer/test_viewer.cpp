@@ -173,25 +173,25 @@ TEST_F(Viewer, ParameterChangeRerunsTheCurrentFrame)
 	const size_t nodes = m.groundAware().lastFrame().detection.nodes.size();
 	ASSERT_GT(nodes, 20u);
 	auto o = m.groundOptions();
-	o.K = 20;  // far fewer RRT iterations
+	o.pipeline.rrt.iterations = 20;	 // K: far fewer RRT iterations
 	m.applyGroundOptions(o);
 	EXPECT_EQ(m.current(), 5);
 	EXPECT_LT(m.groundAware().lastFrame().detection.nodes.size(), nodes);
-	EXPECT_EQ(m.groundOptions().K, 20);
+	EXPECT_EQ(m.groundOptions().pipeline.rrt.iterations, 20);
 	// back to the default: the same tree as before (the step is re-run from the snapshot)
-	o.K = 600;
+	o.pipeline.rrt.iterations = 600;
 	m.applyGroundOptions(o);
 	EXPECT_EQ(m.groundAware().lastFrame().detection.nodes.size(), nodes);
 	// invalid: rejected, options unchanged
-	o.N_th = -1;
+	o.pipeline.rrt.normal_threshold = -1;
 	EXPECT_THROW(m.applyGroundOptions(o), std::invalid_argument);
-	EXPECT_DOUBLE_EQ(m.groundOptions().N_th, 0.2);
+	EXPECT_DOUBLE_EQ(m.groundOptions().pipeline.rrt.normal_threshold, 0.2);
 	// stepping keeps the edited options; going back re-runs from the start with them
 	o = m.groundOptions();
-	o.drop_rays = false;
+	o.pipeline.ism.drop_rays = false;
 	m.applyGroundOptions(o);
 	m.seek(2);
-	EXPECT_FALSE(m.groundOptions().drop_rays);
+	EXPECT_FALSE(m.groundOptions().pipeline.ism.drop_rays);
 	EXPECT_EQ(m.current(), 2);
 }
 

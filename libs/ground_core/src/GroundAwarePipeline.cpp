@@ -55,6 +55,7 @@ void GroundAwarePipeline::resetResult()
 	// As m_result = FrameResult{}, but the detection's vectors keep their
 	// capacity: no heap allocation per frame once they have grown.
 	m_result.valid = false;
+	m_result.samples = 0;
 	m_result.points = 0;
 	m_result.sensor.setZero();
 	m_result.detection.clear();
@@ -93,7 +94,7 @@ const FrameResult& GroundAwarePipeline::process(
 	// 1. The robot-centred 2.5D map of this frame.
 	placeGrid(robot, lattice);
 	m_bins.clear();
-	binSensorFrame(frame, m_params.projectionFilter(robot.z()), m_grid, m_projector, m_bins);
+	m_result.samples = binSensorFrame(frame, m_params.projectionFilter(robot.z()), m_grid, m_projector, m_bins);
 	const auto t1 = clk::now();
 	m_result.points = m_grid.insert(m_bins, m_params.outliers);
 	if (m_params.idw.radius_cells > 0) m_grid.interpolateIdw(m_params.idw);

@@ -74,6 +74,7 @@ struct StageTimes
 struct FrameResult
 {
 	bool valid = false;	 ///< a frame was processed
+	size_t samples = 0;	 ///< samples binned (before the 3-sigma filter)
 	size_t points = 0;	///< samples kept in the 2.5D map
 	Eigen::Vector3d sensor{0, 0, 0};  ///< sensor position (map frame)
 	GroundDetection detection;

@@ -57,7 +57,7 @@ void writeSerializedGz(const mrpt::serialization::CSerializable& obj, const std:
 bool recentreGrid(mrpt::maps::COccupancyGridMap2D& grid, double cx, double cy, int n);
 
 // --------------------------------------------------------------- readers
-// (map_server yaml + PGM: gam::eval::loadRosMap in libs/evaluation.)
+// (map_server yaml + PGM: gam::eval::loadRosMap in libs/ground_eval.)
 
 /** Reads a .gridmap / .gridmap.gz as a stock COccupancyGridMap2D. */
 mrpt::maps::COccupancyGridMap2D readGridmapGz(const std::string& path);

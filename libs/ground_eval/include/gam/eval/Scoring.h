@@ -1,8 +1,7 @@
-// Ground-aware mapping for MRPT -- map evaluation against simulated ground truth.
+// Ground-aware mapping for MRPT -- map evaluation: scoring a map against the ground truth.
 //
-// Scores a 2D occupancy map written in ROS map_server format (yaml + P5 pgm) against
-// the ground truth of gam-simulate: per-object detection by category, floor cells
-// wrongly occupied, floor cells correctly free. Pure C++17, no MRPT.
+// Per-object detection by category, floor cells wrongly occupied, floor cells
+// correctly free. Pure C++17, no MRPT.
 //
 // Rules (README "Map evaluator"):
 //  * Every GT cell is compared with the map cells whose centres fall inside it (the
@@ -23,75 +22,13 @@
 
 #include <cstdint>
 #include <map>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "gam/eval/MapReaders.h"
+
 namespace gam::eval
 {
-/** Every input problem (missing file, bad header, bad value). */
-struct Error : std::runtime_error
-{
-	using std::runtime_error::runtime_error;
-};
-
-/** A ROS map_server map: yaml keys + the image (row 0 = highest y). */
-struct RosMap
-{
-	std::string yamlPath, imagePath, mode = "trinary";
-	double resolution = 0, origin_x = 0, origin_y = 0, origin_yaw = 0;
-	int negate = 0;
-	double occupied_thresh = 0.65, free_thresh = 0.196;
-	int width = 0, height = 0;
-	std::vector<uint8_t> pixels;
-
-	/** p_occupied of cell (col, row from the bottom); mode scale/trinary and negate
-	 * applied (trinary: 1, 0 or 0.5). */
-	double pOcc(int col, int rowFromBottom) const;
-	bool inside(int col, int rowFromBottom) const
-	{
-		return col >= 0 && rowFromBottom >= 0 && col < width && rowFromBottom < height;
-	}
-};
-
-/** Reads the yaml (image, resolution, origin, mode, negate, thresholds) and its P5
- * pgm (maxval 255; the image path is relative to the yaml's folder). Throws Error. */
-RosMap loadRosMap(const std::string& yamlPath);
-
-enum class Label
-{
-	Free,
-	Obstacle,
-	Drop,
-	Unobserved
-};
-const char* labelName(Label l);
-
-struct GtObject
-{
-	int id = 0;
-	std::string name, type, category;
-};
-
-struct GroundTruth
-{
-	std::string prefix;
-	double resolution = 0;
-	int nx = 0, ny = 0;
-	// per cell, index iy * nx + ix
-	std::vector<double> x, y;  ///< cell centres
-	std::vector<Label> label;
-	std::vector<int> objectId;
-	std::vector<GtObject> objects;
-
-	size_t idx(int ix, int iy) const { return size_t(iy) * size_t(nx) + size_t(ix); }
-	const GtObject* object(int id) const;
-};
-
-/** Reads PREFIX_gt.yaml (resolution), PREFIX_gt_labels.csv and PREFIX_gt_objects.csv.
- * Throws Error. */
-GroundTruth loadGroundTruth(const std::string& prefix);
-
 enum class CellState : uint8_t
 {
 	Unknown,
@@ -166,16 +103,5 @@ struct MapScore
 
 /** Scores `map` against `gt`. */
 MapScore evaluate(const GroundTruth& gt, const RosMap& map, const Options& opt = {});
-
-/** The four categories of the report, in order. */
-const std::vector<std::string>& reportCategories();
-
-/** Human-readable table of several maps. */
-std::string formatTable(const GroundTruth& gt, const std::vector<MapScore>& scores, const Options& opt);
-/** JSON document with every number. */
-std::string toJson(const GroundTruth& gt, const std::vector<MapScore>& scores, const Options& opt);
-/** Flat CSV for aggregation: map,reading,record,id,category,n,occupied,free,unknown,detected
- * (record = object | floor | ramp | obstacle). */
-std::string toCsv(const std::vector<MapScore>& scores);
 
 }  // namespace gam::eval

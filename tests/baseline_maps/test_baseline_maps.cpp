@@ -1,4 +1,4 @@
-// Unit tests of the comparison maps of libs/ground_maps:
+// Unit tests of the comparison maps of libs/baseline_maps:
 // CHeightBandOccupancyGrid (heightBandGrid) and COctoMapGrid2D (octoMapGrid).
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
@@ -7,7 +7,7 @@
 #include <mrpt/maps/CMultiMetricMap.h>
 #include <mrpt/maps/COctoMapGrid2D.h>
 #include <mrpt/maps/TMetricMapInitializer.h>
-#include <mrpt/maps/registerGroundAwareMaps.h>
+#include <mrpt/maps/registerBaselineMaps.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/rtti/CObject.h>
 #include <mrpt/serialization/CArchive.h>
@@ -73,7 +73,7 @@ T roundTrip(const T& m)
 
 TEST(ComparisonMaps, RegisteredForIniAndRtti)
 {
-	mrpt::maps::registerGroundAwareMaps();
+	mrpt::maps::registerBaselineMaps();
 	for (const char* n : {"heightBandGrid", "CHeightBandOccupancyGrid", "mrpt::maps::CHeightBandOccupancyGrid",
 						  "octoMapGrid", "COctoMapGrid2D", "mrpt::maps::COctoMapGrid2D"})
 	{
