@@ -2,9 +2,9 @@
 # The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer.
 # usage: scripts/run-sanitizers.sh [--quick] [BUILD_DIR]   (default: build-asan/ in the checkout)
 #
-# --quick (what CI runs): builds only the libraries (ground_core, ground_maps, mapper),
-# ground-aware-mapper, gam-simulate and the suites test_core, test_maps, test_robustness
-# and test_mapper, and runs those four executables (not the simulator, evaluator,
+# --quick (what CI runs): builds only the libraries (ground_core, ground_maps, baseline_maps, ground_mapper),
+# ground-aware-mapper, gam-simulate and the suites test_core, test_maps, test_baseline_maps, test_robustness
+# and test_mapper, and runs those five executables (not the simulator, evaluator,
 # navigation and viewer suites).
 #
 # Configures BUILD_DIR with -fsanitize=address,undefined -fno-sanitize-recover=all
@@ -37,7 +37,7 @@ cmake -S "$here" -B "$build" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
   -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
 if [ $quick = 1 ]; then
-  cmake --build "$build" -j "$jobs" --target test_core test_maps test_robustness test_mapper ground-aware-mapper gam-simulate
+  cmake --build "$build" -j "$jobs" --target test_core test_maps test_baseline_maps test_robustness test_mapper ground-aware-mapper gam-simulate
 else
   cmake --build "$build" -j "$jobs"
 fi
@@ -48,7 +48,7 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 cd "$build"
 if [ $quick = 1 ]; then
   status=0
-  for t in tests/test_core tests/test_maps tests/test_robustness tests/mapper/test_mapper; do
+  for t in tests/test_core tests/test_maps tests/test_baseline_maps tests/test_robustness tests/mapper/test_mapper; do
     echo "== $t (ASan + UBSan)"
     "$build/$t" --gtest_filter='-StockApps.*' --gtest_brief=1 || status=1
   done

@@ -30,7 +30,7 @@
 #include <sstream>
 #include <variant>
 
-#include "ViewerCore.h"
+#include "ViewerScene.h"
 
 using gam::viewer::View;
 using gam::viewer::ViewerModel;

@@ -12,7 +12,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "ViewerCore.h"
+#include "ViewerScene.h"
 
 namespace fs = std::filesystem;
 using gam::viewer::View;

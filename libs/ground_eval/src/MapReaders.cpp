@@ -10,18 +10,13 @@
 #include <sstream>
 
 #include "PathNames.h"
+#include "gam/common/Strings.h"
 
 namespace gam::eval
 {
 namespace
 {
-std::string trim(std::string s)
-{
-	while (!s.empty() && std::isspace((unsigned char)s.back())) s.pop_back();
-	size_t i = 0;
-	while (i < s.size() && std::isspace((unsigned char)s[i])) i++;
-	return s.substr(i);
-}
+using gam::trim;
 
 double toDouble(const std::string& v, const std::string& what)
 {
