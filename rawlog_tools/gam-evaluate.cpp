@@ -97,14 +97,23 @@ int main(int argc, char** argv)
 		"gam-evaluate: scores ROS map_server maps against gam-simulate ground truth "
 		"(per-object detection by category, floor false obstacles, floor free)",
 		' ', "1.0");
-	TCLAP::MultiArg<std::string> argMap("m", "map", "map yaml (ROS map_server); repeat for several maps", true, "YAML", cmd);
-	TCLAP::ValueArg<std::string> argGt("g", "gt", "ground-truth prefix (PREFIX_gt.yaml, PREFIX_gt_labels.csv, PREFIX_gt_objects.csv)", true, "", "PREFIX", cmd);
+	TCLAP::MultiArg<std::string> argMap(
+		"m", "map", "map yaml (ROS map_server); repeat for several maps", true, "YAML", cmd);
+	TCLAP::ValueArg<std::string> argGt(
+		"g", "gt", "ground-truth prefix (PREFIX_gt.yaml, PREFIX_gt_labels.csv, PREFIX_gt_objects.csv)", true, "",
+		"PREFIX", cmd);
 	TCLAP::ValueArg<std::string> argJson("j", "json", "write every number as JSON", false, "", "FILE", cmd);
-	TCLAP::ValueArg<std::string> argCsv("", "csv", "write a flat CSV (per object and cell class) for aggregation", false, "", "FILE", cmd);
-	TCLAP::ValueArg<std::string> argPng("", "png", "write a PNG: ground truth and the maps side by side on the GT grid", false, "", "FILE", cmd);
+	TCLAP::ValueArg<std::string> argCsv(
+		"", "csv", "write a flat CSV (per object and cell class) for aggregation", false, "", "FILE", cmd);
+	TCLAP::ValueArg<std::string> argPng(
+		"", "png", "write a PNG: ground truth and the maps side by side on the GT grid", false, "", "FILE", cmd);
 	TCLAP::ValueArg<std::string> argTitle("", "title", "caption of the PNG", false, "", "TEXT", cmd);
-	TCLAP::ValueArg<int> argTol("", "tolerance-cells", "floor cells this close (cells, Chebyshev) to a GT obstacle/drop are not scored (default 1)", false, 1, "N", cmd);
-	TCLAP::ValueArg<int> argHits("", "min-hits", "occupied cells an object needs to be detected (default 1)", false, 1, "N", cmd);
+	TCLAP::ValueArg<int> argTol(
+		"", "tolerance-cells",
+		"floor cells this close (cells, Chebyshev) to a GT obstacle/drop are not scored (default 1)", false, 1, "N",
+		cmd);
+	TCLAP::ValueArg<int> argHits(
+		"", "min-hits", "occupied cells an object needs to be detected (default 1)", false, 1, "N", cmd);
 	TCLAP::SwitchArg argQuiet("q", "quiet", "no table on stdout", cmd);
 	QuietFailureOutput out;
 	cmd.setOutput(&out);

@@ -23,8 +23,8 @@
 #include <iostream>
 
 #include "gam/sim/GroundTruth.h"
-#include "gam/sim/SceneFile.h"
 #include "gam/sim/KinectObservation.h"
+#include "gam/sim/SceneFile.h"
 #include "gam/sim/Sensors.h"
 
 using namespace gam::sim;
@@ -84,9 +84,9 @@ void writeGroundTruth(const std::string& prefix, const SceneFile& sf, const Grou
 		for (const auto& o : sf.scene.objects)
 		{
 			const auto& b = o.bbox;
-			f << o.id << "," << o.name << "," << o.type << "," << categoryName(o.category) << ","
-			  << b.min().x() << "," << b.min().y() << "," << b.min().z() << "," << b.max().x() << ","
-			  << b.max().y() << "," << b.max().z() << "\n";
+			f << o.id << "," << o.name << "," << o.type << "," << categoryName(o.category) << "," << b.min().x() << ","
+			  << b.min().y() << "," << b.min().z() << "," << b.max().x() << "," << b.max().y() << "," << b.max().z()
+			  << "\n";
 		}
 	}
 	{
@@ -235,14 +235,13 @@ int main(int argc, char** argv)
 			}
 			char buf[256];
 			std::snprintf(
-				buf, sizeof(buf), "%zu,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", i, tsec, truth[i].x,
-				truth[i].y, truth[i].yaw, odo[i].x, odo[i].y, odo[i].yaw);
+				buf, sizeof(buf), "%zu,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", i, tsec, truth[i].x, truth[i].y,
+				truth[i].yaw, odo[i].x, odo[i].y, odo[i].yaw);
 			pathCsv << buf;
 		}
 		fo.close();
 		writeGroundTruth(prefix, sf, gt);
-		const double secs =
-			std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+		const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 		size_t nObs = 0, nDrop = 0, nFree = 0, nUnobs = 0;
 		for (int iy = 0; iy < gt.spec.ny(); iy++)
 			for (int ix = 0; ix < gt.spec.nx(); ix++)
@@ -254,11 +253,10 @@ int main(int argc, char** argv)
 				nUnobs += l == Label::Unobserved;
 			}
 		std::cout << "gam-simulate: " << truth.size() << " frames -> " << prefix << ".rawlog ("
-				  << (leddarOn ? "odometry+kinect+leddar" : "odometry+kinect") << ", "
-				  << (noise ? "noisy" : "exact") << ", seed " << seed << "), "
-				  << double(validPix) / std::max<size_t>(1, truth.size()) << " valid px/frame; GT "
-				  << gt.spec.nx() << "x" << gt.spec.ny() << " cells: free " << nFree << ", obstacle "
-				  << nObs << ", drop " << nDrop << ", unobserved " << nUnobs << "; " << secs << " s"
+				  << (leddarOn ? "odometry+kinect+leddar" : "odometry+kinect") << ", " << (noise ? "noisy" : "exact")
+				  << ", seed " << seed << "), " << double(validPix) / std::max<size_t>(1, truth.size())
+				  << " valid px/frame; GT " << gt.spec.nx() << "x" << gt.spec.ny() << " cells: free " << nFree
+				  << ", obstacle " << nObs << ", drop " << nDrop << ", unobserved " << nUnobs << "; " << secs << " s"
 				  << std::endl;
 		return 0;
 	}

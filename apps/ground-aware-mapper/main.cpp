@@ -24,10 +24,7 @@ class QuietFailureOutput : public TCLAP::StdOutput
 {
    public:
 	std::string error;
-	void failure(TCLAP::CmdLineInterface&, TCLAP::ArgException& e) override
-	{
-		error = e.argId() + ": " + e.error();
-	}
+	void failure(TCLAP::CmdLineInterface&, TCLAP::ArgException& e) override { error = e.argId() + ": " + e.error(); }
 };
 
 int fail(int code, std::string msg)
@@ -52,11 +49,12 @@ int main(int argc, char** argv)
 			"2D grid of the .ini, <label>.yaml/.pgm (ROS map_server), <label>.gridmap.gz and <label>.png, "
 			"plus the elevation map, ground_planes.csv and timing.csv into --out.",
 			' ', "0.1.0");
-		TCLAP::ValueArg<std::string> aRawlog("r", "rawlog", "input rawlog (either format)", false, "", "FILE.rawlog", cmd);
+		TCLAP::ValueArg<std::string> aRawlog(
+			"r", "rawlog", "input rawlog (either format)", false, "", "FILE.rawlog", cmd);
 		TCLAP::ValueArg<std::string> aOut("o", "out", "output directory (created if missing)", false, "", "DIR", cmd);
 		TCLAP::ValueArg<std::string> aConfig(
-			"c", "config", "map configuration (.ini); default: the embedded config/ground-aware-mapper.ini", false,
-			"", "FILE.ini", cmd);
+			"c", "config", "map configuration (.ini); default: the embedded config/ground-aware-mapper.ini", false, "",
+			"FILE.ini", cmd);
 		TCLAP::ValueArg<std::string> aSection(
 			"s", "section", "section of the .ini with the <map>_count keys", false, "map", "NAME", cmd);
 		TCLAP::SwitchArg aPrint("", "print-default-config", "print the embedded default .ini and exit", cmd);
@@ -117,8 +115,7 @@ int main(int argc, char** argv)
 		gam::mapper::Mapper mapper(o);
 		for (const auto& w : mapper.warnings()) std::cerr << kApp << ": warning: " << w << std::endl;
 		const auto s = mapper.run();
-		std::cout << kApp << ": " << s.text() << "outputs: " << s.files.size() << " files in " << o.outDir
-				  << std::endl;
+		std::cout << kApp << ": " << s.text() << "outputs: " << s.files.size() << " files in " << o.outDir << std::endl;
 		return 0;
 	}
 	catch (const gam::mapper::ConfigError& e)

@@ -1,8 +1,8 @@
 // Ground-aware mapping for MRPT -- navigation example (library part).
 #include "NavExample.h"
 
-#include <mrpt/img/CImage.h>
 #include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/img/CImage.h>
 #include <mrpt/kinematics/CVehicleSimul_DiffDriven.h>
 #include <mrpt/nav/planners/PlannerSimple2D.h>
 #include <mrpt/nav/reactive/CReactiveNavigationSystem.h>
@@ -10,10 +10,10 @@
 #include <mrpt/system/datetime.h>
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "gam/sim/KinectObservation.h"
@@ -34,8 +34,7 @@ mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
 	const gam::sim::SceneFile& sf, const gam::sim::Pose2& robot, std::mt19937& rng)
 {
 	const gam::sim::KinectModel kinect(sf.kinect);
-	const gam::sim::Pose3 robot3 =
-		gam::sim::Pose3::fromXYZYPR(robot.x, robot.y, 0, robot.yaw, 0, 0);
+	const gam::sim::Pose3 robot3 = gam::sim::Pose3::fromXYZYPR(robot.x, robot.y, 0, robot.yaw, 0, 0);
 	const gam::sim::DepthFrame fr = kinect.render(sf.scene, robot3 * sf.kinect_pose, rng);
 
 	return gam::sim::toKinectObservation(sf.kinect, fr, toCPose3D(sf.kinect_pose));
@@ -82,8 +81,8 @@ void buildMaps(const gam::sim::SceneFile& sfIn, const MapOptions& opts, NavMaps&
 }
 
 PlanResult planPath(
-	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPoint2D& start,
-	const mrpt::math::TPoint2D& goal, const PlanOptions& opts)
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPoint2D& start, const mrpt::math::TPoint2D& goal,
+	const PlanOptions& opts)
 {
 	mrpt::nav::PlannerSimple2D planner;
 	planner.robotRadius = opts.robotRadius;
@@ -93,8 +92,8 @@ PlanResult planPath(
 	PlanResult r;
 	bool notFound = true;
 	planner.computePath(
-		grid, mrpt::poses::CPose2D(start.x, start.y, 0), mrpt::poses::CPose2D(goal.x, goal.y, 0),
-		r.path, notFound, opts.maxSearchPathLength);
+		grid, mrpt::poses::CPose2D(start.x, start.y, 0), mrpt::poses::CPose2D(goal.x, goal.y, 0), r.path, notFound,
+		opts.maxSearchPathLength);
 	r.found = !notFound && !r.path.empty();
 	if (!r.found) return r;
 
@@ -113,8 +112,7 @@ PlanResult planPath(
 }
 
 mrpt::maps::CSimplePointsMap obstaclePointsRobotFrame(
-	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::poses::CPose2D& robotPose,
-	const ObstacleOptions& opts)
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::poses::CPose2D& robotPose, const ObstacleOptions& opts)
 {
 	mrpt::maps::CSimplePointsMap pts;
 	const double r2 = opts.maxRange * opts.maxRange;
@@ -178,8 +176,8 @@ const char* stateName(mrpt::nav::CAbstractNavigator::TState s)
 }  // namespace
 
 ReactiveResult runReactiveNavigation(
-	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start,
-	const mrpt::math::TPoint2D& goal, const ReactiveOptions& opts)
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start, const mrpt::math::TPoint2D& goal,
+	const ReactiveOptions& opts)
 {
 	std::ifstream f(opts.baseConfig);
 	if (!f) throw std::runtime_error("cannot read the reactive navigator config " + opts.baseConfig);
@@ -255,9 +253,8 @@ double distanceToHoles(const gam::sim::Scene& scene, double x, double y, double 
 }
 
 void savePathPicture(
-	const mrpt::maps::COccupancyGridMap2D& grid, const PlanResult& plan,
-	const mrpt::math::TPoint2D& start, const mrpt::math::TPoint2D& goal, const std::string& file,
-	int scale)
+	const mrpt::maps::COccupancyGridMap2D& grid, const PlanResult& plan, const mrpt::math::TPoint2D& start,
+	const mrpt::math::TPoint2D& goal, const std::string& file, int scale)
 {
 	const int W = int(grid.getSizeX()), H = int(grid.getSizeY());
 	mrpt::img::CImage img(W * scale, H * scale, mrpt::img::CH_RGB);

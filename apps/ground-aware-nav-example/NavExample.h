@@ -41,12 +41,12 @@ struct NavMaps
 	mrpt::maps::CGroundAwareOccupancyGrid groundAware;
 	mrpt::maps::CHeightBandOccupancyGrid heightBand;
 	std::vector<mrpt::poses::CPose2D> robotPoses;  ///< one per frame (true poses)
-	size_t framesWithGround = 0;  ///< frames where RRT-GPD found the floor
+	size_t framesWithGround = 0;                   ///< frames where RRT-GPD found the floor
 };
 
 struct MapOptions
 {
-	bool noise = true;	///< simulate sensor noise (the scene's Kinect model)
+	bool noise = true;  ///< simulate sensor noise (the scene's Kinect model)
 	unsigned seed = 1;
 };
 
@@ -57,7 +57,7 @@ void buildMaps(const gam::sim::SceneFile& sf, const MapOptions& opts, NavMaps& o
 
 struct PlanOptions
 {
-	float robotRadius = 0.30f;	///< PlannerSimple2D::robotRadius [m]
+	float robotRadius = 0.30f;  ///< PlannerSimple2D::robotRadius [m]
 	/** PlannerSimple2D::occupancyThreshold: cells whose FREE probability is
 	 * below it are obstacles (unknown cells, 0.5, are traversable). */
 	float occupancyThreshold = 0.45f;
@@ -68,21 +68,21 @@ struct PlanOptions
 struct PlanResult
 {
 	bool found = false;
-	std::deque<mrpt::math::TPoint2D> path;	///< map frame, start to goal
-	double length = 0;	///< [m]
+	std::deque<mrpt::math::TPoint2D> path;  ///< map frame, start to goal
+	double length = 0;                      ///< [m]
 	/** Largest |y - straight line| of the path from start to goal [m]. */
 	double maxDeviation = 0;
 };
 
 PlanResult planPath(
-	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPoint2D& start,
-	const mrpt::math::TPoint2D& goal, const PlanOptions& opts = {});
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPoint2D& start, const mrpt::math::TPoint2D& goal,
+	const PlanOptions& opts = {});
 
 struct ObstacleOptions
 {
 	/** A cell is an obstacle if its FREE probability is below this. */
 	float maxFreeProbability = 0.4f;
-	double maxRange = 6.0;	///< only cells within this distance of the robot [m]
+	double maxRange = 6.0;  ///< only cells within this distance of the robot [m]
 	/** z of every point. The grid is 2D; any z inside the reactive navigator's
 	 * [min_obstacles_height, max_obstacles_height] works (defaults 0..10). */
 	float z = 0.1f;
@@ -100,22 +100,22 @@ struct ReactiveOptions
 	/** MRPT's example reactive-navigator configuration (package mrpt-common);
 	 * the keys below override it. */
 	std::string baseConfig = "/usr/share/mrpt/config_files/navigation-ptgs/reactive2d_config.ini";
-	std::string cacheDir = "/tmp";	///< PTG look-up table cache files go here
-	double robotHalfSize = 0.25;  ///< square robot footprint, half side [m]
-	double refDistance = 4.0;  ///< PTG range [m]
-	double maxSpeed = 0.5;	///< [m/s]
-	double maxTime = 40;  ///< simulated seconds
-	double dt = 0.05;  ///< simulation step [s]
+	std::string cacheDir = "/tmp";  ///< PTG look-up table cache files go here
+	double robotHalfSize = 0.25;    ///< square robot footprint, half side [m]
+	double refDistance = 4.0;       ///< PTG range [m]
+	double maxSpeed = 0.5;          ///< [m/s]
+	double maxTime = 40;            ///< simulated seconds
+	double dt = 0.05;               ///< simulation step [s]
 	float targetAllowedDistance = 0.3f;
 	ObstacleOptions obstacles;
 };
 
 struct ReactiveResult
 {
-	bool reached = false;  ///< the navigator ended (IDLE) within targetAllowedDistance
-	std::string endState;  ///< IDLE / NAVIGATING / SUSPENDED / NAV_ERROR
+	bool reached = false;                         ///< the navigator ended (IDLE) within targetAllowedDistance
+	std::string endState;                         ///< IDLE / NAVIGATING / SUSPENDED / NAV_ERROR
 	std::vector<mrpt::math::TPose2D> trajectory;  ///< simulated robot poses
-	double seconds = 0;	 ///< simulated time used
+	double seconds = 0;                           ///< simulated time used
 };
 
 /** Closed loop with MRPT's reactive navigator: a CReactiveNavigationSystem
@@ -124,8 +124,8 @@ struct ReactiveResult
  * senseObstacles() returns obstaclePointsRobotFrame(grid, current pose). The
  * grid is static (already mapped). Throws if the base config is missing. */
 ReactiveResult runReactiveNavigation(
-	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start,
-	const mrpt::math::TPoint2D& goal, const ReactiveOptions& opts = {});
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start, const mrpt::math::TPoint2D& goal,
+	const ReactiveOptions& opts = {});
 
 /** Smallest distance [m] from a point to the union of the scene's holes
  * (0 inside one), sampled on a grid of `step` metres inside each hole. */
@@ -134,8 +134,7 @@ double distanceToHoles(const gam::sim::Scene& scene, double x, double y, double 
 /** Writes a PNG picture of the grid with the path drawn over it (red) and the
  * start (green) and goal (blue), one pixel per cell scaled by `scale`. */
 void savePathPicture(
-	const mrpt::maps::COccupancyGridMap2D& grid, const PlanResult& plan,
-	const mrpt::math::TPoint2D& start, const mrpt::math::TPoint2D& goal, const std::string& file,
-	int scale = 4);
+	const mrpt::maps::COccupancyGridMap2D& grid, const PlanResult& plan, const mrpt::math::TPoint2D& start,
+	const mrpt::math::TPoint2D& goal, const std::string& file, int scale = 4);
 
 }  // namespace gam::nav

@@ -46,8 +46,8 @@ int main(int argc, char** argv)
 		TCLAP::SwitchArg argNoNoise("", "no-noise", "exact sensor", cmd);
 		TCLAP::SwitchArg argNoReactive("", "no-reactive", "skip the CReactiveNavigationSystem runs", cmd);
 		TCLAP::ValueArg<std::string> argReactiveCfg(
-			"", "reactive-config", "base reactive navigator .ini", false,
-			gam::nav::ReactiveOptions{}.baseConfig, "FILE", cmd);
+			"", "reactive-config", "base reactive navigator .ini", false, gam::nav::ReactiveOptions{}.baseConfig,
+			"FILE", cmd);
 		cmd.parse(argc, argv);
 
 		const auto sf = gam::sim::parseSceneFile(argScene.getValue());
@@ -76,8 +76,7 @@ int main(int argc, char** argv)
 		{
 			const auto plan = gam::nav::planPath(*it.grid, start, goal, po);
 			double minHole = 1e9;
-			for (const auto& p : plan.path)
-				minHole = std::min(minHole, gam::nav::distanceToHoles(sf.scene, p.x, p.y));
+			for (const auto& p : plan.path) minHole = std::min(minHole, gam::nav::distanceToHoles(sf.scene, p.x, p.y));
 			char buf[300];
 			if (plan.found)
 				std::snprintf(
@@ -117,12 +116,11 @@ int main(int argc, char** argv)
 					buf, sizeof(buf),
 					"%-13s reactive (CReactiveNavigationSystem): %s, %s after %.1f s, closest to a "
 					"hole %.2f m -> %s\n",
-					it.name, r.reached ? "goal reached" : "goal NOT reached", r.endState.c_str(),
-					r.seconds, minHole, minHole == 0 ? "DROVE OVER the hole" : "avoided the hole");
+					it.name, r.reached ? "goal reached" : "goal NOT reached", r.endState.c_str(), r.seconds, minHole,
+					minHole == 0 ? "DROVE OVER the hole" : "avoided the hole");
 				std::cout << buf;
 				if (!out.empty())
-					gam::nav::savePathPicture(
-						*it.grid, traj, start, goal, out + "/" + it.name + "_reactive.png");
+					gam::nav::savePathPicture(*it.grid, traj, start, goal, out + "/" + it.name + "_reactive.png");
 			}
 		}
 
@@ -138,8 +136,8 @@ int main(int argc, char** argv)
 			robot.composePoint(x, y, gx, gy);
 			inHole += gam::nav::distanceToHoles(sf.scene, gx, gy) == 0;
 		}
-		std::cout << "obstacle points (robot frame, for CReactiveNavigationSystem): "
-				  << obstacles.size() << ", " << inHole << " of them inside a hole\n";
+		std::cout << "obstacle points (robot frame, for CReactiveNavigationSystem): " << obstacles.size() << ", "
+				  << inHole << " of them inside a hole\n";
 		if (!out.empty())
 		{
 			obstacles.save2D_to_text_file(out + "/obstacles_robot_frame.txt");
@@ -149,8 +147,7 @@ int main(int argc, char** argv)
 	}
 	catch (const TCLAP::ArgException& e)
 	{
-		std::cerr << "ground-aware-nav-example: error: " << e.error() << " for " << e.argId()
-				  << std::endl;
+		std::cerr << "ground-aware-nav-example: error: " << e.error() << " for " << e.argId() << std::endl;
 		return 2;
 	}
 	catch (const std::exception& e)

@@ -9,9 +9,9 @@
 //            [--width 800 --height 600]
 // Batch mode (--screenshot-dir DIR --exit) renders every view off-screen with
 // CFBORender into DIR/<view>.png and exits: no display needed.
+#include <gam/maps/IniFields.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/gui/CWxGLCanvasBase.h>
-#include <gam/maps/IniFields.h>
 #include <mrpt/maps/registerBaselineMaps.h>
 #include <mrpt/maps/registerGroundAwareMaps.h>
 #include <wx/dirdlg.h>
@@ -41,7 +41,7 @@ namespace
 struct Args
 {
 	std::string rawlog, config, section = "map", shotDir;
-	int frame = -1;	 ///< -1 = the last one
+	int frame = -1;  ///< -1 = the last one
 	bool exit = false;
 	int width = 800, height = 600;
 	std::string guiSnapshot;  ///< (self-check) capture the GUI window into this PNG and quit
@@ -79,7 +79,10 @@ int runBatch(const Args& a)
 class ViewCanvas : public mrpt::gui::CWxGLCanvasBase
 {
    public:
-	ViewCanvas(wxWindow* parent, View v) : CWxGLCanvasBase(parent, wxID_ANY, wxDefaultPosition, wxSize(300, 200)), m_view(v) {}
+	ViewCanvas(wxWindow* parent, View v)
+		: CWxGLCanvasBase(parent, wxID_ANY, wxDefaultPosition, wxSize(300, 200)), m_view(v)
+	{
+	}
 	View view() const { return m_view; }
 	/** Rebuilds the scene; resets the camera if `resetCamera`. */
 	void update(const ViewerModel& m, bool resetCamera)
@@ -123,7 +126,10 @@ enum
 class ViewerFrame : public wxFrame
 {
    public:
-	explicit ViewerFrame(const Args& a) : wxFrame(nullptr, wxID_ANY, "ground-aware-viewer", wxDefaultPosition, wxSize(1400, 900)), m_args(a), m_timer(this, ID_TIMER)
+	explicit ViewerFrame(const Args& a)
+		: wxFrame(nullptr, wxID_ANY, "ground-aware-viewer", wxDefaultPosition, wxSize(1400, 900)),
+		  m_args(a),
+		  m_timer(this, ID_TIMER)
 	{
 		auto* top = new wxPanel(this);
 		auto* bar = new wxBoxSizer(wxHORIZONTAL);
@@ -159,18 +165,26 @@ class ViewerFrame : public wxFrame
 			s->Add(box, prop, wxEXPAND | wxALL, 2);
 			m_canvases.push_back(c);
 		};
-		addCanvas(row1, View::Frame3D, "Current frame: point cloud, 2.5D voxels (green ground, red obstacle, magenta drop), ground plane, RRT tree", 1);
+		addCanvas(
+			row1, View::Frame3D,
+			"Current frame: point cloud, 2.5D voxels (green ground, red obstacle, magenta drop), ground plane, RRT "
+			"tree",
+			1);
 		addCanvas(row1, View::Map3D, "Accumulated: 2.5D map, point cloud, ground-aware grid below", 1);
 		vs->Add(row1, 3, wxEXPAND);
 		auto* row2 = new wxBoxSizer(wxHORIZONTAL);
-		addCanvas(row2, View::Grids, "Grids: ground-aware | height-band | octomap (white free, black occupied, blue unknown)", 3);
-		m_status = new wxTextCtrl(views, wxID_ANY, "", wxDefaultPosition, wxDefaultSize, wxTE_MULTILINE | wxTE_READONLY);
+		addCanvas(
+			row2, View::Grids, "Grids: ground-aware | height-band | octomap (white free, black occupied, blue unknown)",
+			3);
+		m_status =
+			new wxTextCtrl(views, wxID_ANY, "", wxDefaultPosition, wxDefaultSize, wxTE_MULTILINE | wxTE_READONLY);
 		m_status->SetFont(wxFont(9, wxFONTFAMILY_TELETYPE, wxFONTSTYLE_NORMAL, wxFONTWEIGHT_NORMAL));
 		row2->Add(m_status, 2, wxEXPAND | wxALL, 2);
 		vs->Add(row2, 2, wxEXPAND);
 		views->SetSizer(vs);
 
-		m_props = new wxPropertyGrid(split, wxID_ANY, wxDefaultPosition, wxDefaultSize, wxPG_SPLITTER_AUTO_CENTER | wxPG_DEFAULT_STYLE);
+		m_props = new wxPropertyGrid(
+			split, wxID_ANY, wxDefaultPosition, wxDefaultSize, wxPG_SPLITTER_AUTO_CENTER | wxPG_DEFAULT_STYLE);
 		split->SplitVertically(views, m_props, -330);
 		split->SetSashGravity(1.0);
 
@@ -179,19 +193,31 @@ class ViewerFrame : public wxFrame
 		main->Add(split, 1, wxEXPAND);
 		top->SetSizer(main);
 
-		Bind(wxEVT_BUTTON, [this](wxCommandEvent&) { onOpen(); }, ID_OPEN);
-		Bind(wxEVT_BUTTON, [this](wxCommandEvent&) { onOpenIni(); }, ID_OPEN_INI);
-		Bind(wxEVT_BUTTON, [this](wxCommandEvent&) { go(0); }, ID_FIRST);
-		Bind(wxEVT_BUTTON, [this](wxCommandEvent&) { go(m_model.current() - 1); }, ID_PREV);
-		Bind(wxEVT_BUTTON, [this](wxCommandEvent&) { go(m_model.current() + 1); }, ID_NEXT);
-		Bind(wxEVT_BUTTON, [this](wxCommandEvent&) { go(int(m_model.stepCount()) - 1); }, ID_LAST);
-		Bind(wxEVT_BUTTON, [this](wxCommandEvent&) { togglePlay(); }, ID_PLAY);
-		Bind(wxEVT_BUTTON, [this](wxCommandEvent&) { onExport(); }, ID_EXPORT);
-		Bind(wxEVT_SLIDER, [this](wxCommandEvent&) { go(m_slider->GetValue()); }, ID_SLIDER);
-		Bind(wxEVT_TIMER, [this](wxTimerEvent&) {
-			if (!m_model.next()) togglePlay();
-			refreshAll();
-		}, ID_TIMER);
+		Bind(
+			wxEVT_BUTTON, [this](wxCommandEvent&) { onOpen(); }, ID_OPEN);
+		Bind(
+			wxEVT_BUTTON, [this](wxCommandEvent&) { onOpenIni(); }, ID_OPEN_INI);
+		Bind(
+			wxEVT_BUTTON, [this](wxCommandEvent&) { go(0); }, ID_FIRST);
+		Bind(
+			wxEVT_BUTTON, [this](wxCommandEvent&) { go(m_model.current() - 1); }, ID_PREV);
+		Bind(
+			wxEVT_BUTTON, [this](wxCommandEvent&) { go(m_model.current() + 1); }, ID_NEXT);
+		Bind(
+			wxEVT_BUTTON, [this](wxCommandEvent&) { go(int(m_model.stepCount()) - 1); }, ID_LAST);
+		Bind(
+			wxEVT_BUTTON, [this](wxCommandEvent&) { togglePlay(); }, ID_PLAY);
+		Bind(
+			wxEVT_BUTTON, [this](wxCommandEvent&) { onExport(); }, ID_EXPORT);
+		Bind(
+			wxEVT_SLIDER, [this](wxCommandEvent&) { go(m_slider->GetValue()); }, ID_SLIDER);
+		Bind(
+			wxEVT_TIMER,
+			[this](wxTimerEvent&) {
+				if (!m_model.next()) togglePlay();
+				refreshAll();
+			},
+			ID_TIMER);
 		m_props->Bind(wxEVT_PG_CHANGED, &ViewerFrame::onPropChanged, this);
 
 		try
@@ -298,7 +324,7 @@ class ViewerFrame : public wxFrame
 		try
 		{
 			wxBusyCursor busy;
-			m_model.applyGroundOptions(opts);	// validates, then re-runs the current frame
+			m_model.applyGroundOptions(opts);  // validates, then re-runs the current frame
 		}
 		catch (const std::exception& e)
 		{
@@ -342,7 +368,8 @@ class ViewerFrame : public wxFrame
 
 	void onOpen()
 	{
-		wxFileDialog dlg(this, "Open rawlog", "", "", "Rawlogs (*.rawlog)|*.rawlog|All files|*", wxFD_OPEN | wxFD_FILE_MUST_EXIST);
+		wxFileDialog dlg(
+			this, "Open rawlog", "", "", "Rawlogs (*.rawlog)|*.rawlog|All files|*", wxFD_OPEN | wxFD_FILE_MUST_EXIST);
 		if (dlg.ShowModal() != wxID_OK) return;
 		try
 		{
@@ -359,7 +386,9 @@ class ViewerFrame : public wxFrame
 
 	void onOpenIni()
 	{
-		wxFileDialog dlg(this, "Open map configuration", "", "", "INI files (*.ini)|*.ini|All files|*", wxFD_OPEN | wxFD_FILE_MUST_EXIST);
+		wxFileDialog dlg(
+			this, "Open map configuration", "", "", "INI files (*.ini)|*.ini|All files|*",
+			wxFD_OPEN | wxFD_FILE_MUST_EXIST);
 		if (dlg.ShowModal() != wxID_OK) return;
 		try
 		{
@@ -412,7 +441,7 @@ Args g_args;
 class ViewerApp : public wxApp
 {
    public:
-	bool OnInit() override	// no wxApp::OnInit(): our own command line
+	bool OnInit() override  // no wxApp::OnInit(): our own command line
 	{
 		wxInitAllImageHandlers();
 		auto* f = new ViewerFrame(g_args);
@@ -433,14 +462,22 @@ int main(int argc, char** argv)
 		TCLAP::CmdLine cmd("ground-aware-viewer", ' ', "0.1");
 		TCLAP::UnlabeledValueArg<std::string> argFile("file", "rawlog", false, "", "FILE.rawlog", cmd);
 		TCLAP::ValueArg<std::string> argRawlog("r", "rawlog", "rawlog to open", false, "", "FILE", cmd);
-		TCLAP::ValueArg<std::string> argConfig("c", "config", "map .ini (ground-aware-mapper format)", false, "", "FILE.ini", cmd);
-		TCLAP::ValueArg<std::string> argSection("s", "section", "section with the <map>_count keys", false, "map", "NAME", cmd);
-		TCLAP::ValueArg<int> argFrame("f", "frame", "depth frame (step) to show, 0-based; default: batch the last, GUI the first", false, -1, "N", cmd);
-		TCLAP::ValueArg<std::string> argShots("", "screenshot-dir", "write DIR/<view>.png of every view (with --exit: batch mode, no display)", false, "", "DIR", cmd);
+		TCLAP::ValueArg<std::string> argConfig(
+			"c", "config", "map .ini (ground-aware-mapper format)", false, "", "FILE.ini", cmd);
+		TCLAP::ValueArg<std::string> argSection(
+			"s", "section", "section with the <map>_count keys", false, "map", "NAME", cmd);
+		TCLAP::ValueArg<int> argFrame(
+			"f", "frame", "depth frame (step) to show, 0-based; default: batch the last, GUI the first", false, -1, "N",
+			cmd);
+		TCLAP::ValueArg<std::string> argShots(
+			"", "screenshot-dir", "write DIR/<view>.png of every view (with --exit: batch mode, no display)", false, "",
+			"DIR", cmd);
 		TCLAP::SwitchArg argExit("", "exit", "batch mode: render the screenshots and exit", cmd);
 		TCLAP::ValueArg<int> argW("", "width", "screenshot width [px]", false, 800, "W", cmd);
 		TCLAP::ValueArg<int> argH("", "height", "screenshot height [px]", false, 600, "H", cmd);
-		TCLAP::ValueArg<std::string> argGuiShot("", "gui-snapshot", "(self-check) open the GUI, edit K, save the window to FILE.png and quit", false, "", "FILE", cmd);
+		TCLAP::ValueArg<std::string> argGuiShot(
+			"", "gui-snapshot", "(self-check) open the GUI, edit K, save the window to FILE.png and quit", false, "",
+			"FILE", cmd);
 		cmd.parse(argc, argv);
 		Args a;
 		a.rawlog = argRawlog.isSet() ? argRawlog.getValue() : argFile.getValue();

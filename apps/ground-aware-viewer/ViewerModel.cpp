@@ -11,8 +11,8 @@
 #include <mrpt/opengl/CGridPlaneXY.h>
 #include <mrpt/opengl/CPointCloud.h>
 #include <mrpt/opengl/CPointCloudColoured.h>
-#include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/opengl/CSetOfLines.h>
+#include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/opengl/CSetOfTriangles.h>
 #include <mrpt/opengl/CTexturedPlane.h>
 #include <mrpt/opengl/stock_objects.h>
@@ -218,7 +218,7 @@ void ViewerModel::rerunCurrent()
 
 void ViewerModel::applyGroundOptions(const CGroundAwareOccupancyGrid::TGroundAwareOptions& o)
 {
-	m_ga->setGroundOptions(o);	// validates first: unchanged if it throws
+	m_ga->setGroundOptions(o);  // validates first: unchanged if it throws
 	rerunCurrent();
 }
 
@@ -263,9 +263,8 @@ void ViewerModel::updatePoints()
 	else if (obs.hasPoints3D)
 		for (size_t i = 0; i < obs.points3D_x.size(); i++)
 		{
-			const auto p = pose +
-						   (obs.sensorPose + mrpt::poses::CPoint3D(
-												 obs.points3D_x[i], obs.points3D_y[i], obs.points3D_z[i]));
+			const auto p = pose + (obs.sensorPose +
+								   mrpt::poses::CPoint3D(obs.points3D_x[i], obs.points3D_y[i], obs.points3D_z[i]));
 			pts.insertPoint(p.x(), p.y(), p.z());
 		}
 	const auto& xs = pts.getPointsBufferRef_x();
@@ -288,24 +287,23 @@ std::string ViewerModel::statusText() const
 	}
 	const Step& s = m_steps[size_t(m_current)];
 	const auto p = s.poses.back();
-	o << "  frames " << s.firstFrame << ".." << (s.firstFrame + s.obs.size() - 1) << "  robot ("
-	  << p.x() << ", " << p.y() << ", " << mrpt::RAD2DEG(p.yaw()) << " deg)\n";
+	o << "  frames " << s.firstFrame << ".." << (s.firstFrame + s.obs.size() - 1) << "  robot (" << p.x() << ", "
+	  << p.y() << ", " << mrpt::RAD2DEG(p.yaw()) << " deg)\n";
 	const auto& d = m_ga->lastFrame();
 	if (s.has3D && d.valid)
 	{
 		o << "ground: " << d.detection.describe() << "\n";
-		o << "voxels: ground " << d.ism.ground << ", obstacle " << d.ism.obstacle << ", drop "
-		  << d.ism.drop << ", overhead " << d.ism.overhead << ", out of range " << d.ism.out_of_range
-		  << ", drop-ray cells " << d.ism.drop_ray_cells << "; points " << d.points << "\n";
+		o << "voxels: ground " << d.ism.ground << ", obstacle " << d.ism.obstacle << ", drop " << d.ism.drop
+		  << ", overhead " << d.ism.overhead << ", out of range " << d.ism.out_of_range << ", drop-ray cells "
+		  << d.ism.drop_ray_cells << "; points " << d.points << "\n";
 		o << "stages [ms]: projection " << d.ms.projection << ", outliers " << d.ms.outliers << ", ground "
 		  << d.ms.ground << ", ism " << d.ms.ism << ", update " << m_ga->lastFrameTimes().update << ", total "
 		  << m_ga->lastFrameTimes().total << "\n";
 	}
 	else
 		o << "(no 3D scan in this step)\n";
-	o << "insert [ms]: ground_aware " << m_timing.groundAware << ", height_band "
-	  << m_timing.heightBand << ", octomap " << m_timing.octomap << ", elevation "
-	  << m_timing.elevation << "\n";
+	o << "insert [ms]: ground_aware " << m_timing.groundAware << ", height_band " << m_timing.heightBand << ", octomap "
+	  << m_timing.octomap << ", elevation " << m_timing.elevation << "\n";
 	return o.str();
 }
 

@@ -31,8 +31,8 @@ struct Step
 	std::vector<mrpt::obs::CObservation::Ptr> obs;
 	std::vector<mrpt::poses::CPose3D> poses;  ///< robot pose of each observation
 	bool has3D = false;
-	size_t index3D = 0;	 ///< position of the 3D scan in obs (when has3D)
-	size_t firstFrame = 0;	///< frame index (as ground-aware-mapper counts) of obs[0]
+	size_t index3D = 0;     ///< position of the 3D scan in obs (when has3D)
+	size_t firstFrame = 0;  ///< frame index (as ground-aware-mapper counts) of obs[0]
 };
 
 /** Per-step timings [ms] of each map's insertObservation(). */

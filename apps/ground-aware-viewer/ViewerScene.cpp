@@ -11,8 +11,8 @@
 #include <mrpt/opengl/CGridPlaneXY.h>
 #include <mrpt/opengl/CPointCloud.h>
 #include <mrpt/opengl/CPointCloudColoured.h>
-#include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/opengl/CSetOfLines.h>
+#include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/opengl/CSetOfTriangles.h>
 #include <mrpt/opengl/CTexturedPlane.h>
 #include <mrpt/opengl/stock_objects.h>
@@ -52,8 +52,7 @@ const char* viewName(View v)
 
 std::vector<View> allViews()
 {
-	return {View::Frame3D,		   View::Map3D,			 View::Grids,
-			View::GridGroundAware, View::GridHeightBand, View::GridOctomap};
+	return {View::Frame3D, View::Map3D, View::Grids, View::GridGroundAware, View::GridHeightBand, View::GridOctomap};
 }
 
 Box gridViewBox(const ViewerModel& m)
@@ -99,8 +98,7 @@ using mrpt::img::TColor;
 
 /** The grid cells inside `b` as a texture (row 0 = lowest y): grey = free
  * probability, never-observed cells (exactly 0.5) light blue. */
-CTexturedPlane::Ptr gridTexture(
-	const mrpt::maps::COccupancyGridMap2D& g, const Box& b, double res, double dx)
+CTexturedPlane::Ptr gridTexture(const mrpt::maps::COccupancyGridMap2D& g, const Box& b, double res, double dx)
 {
 	const int W = std::max(1, int(std::lround(b.w() / res)));
 	const int H = std::max(1, int(std::lround(b.h() / res)));
@@ -159,8 +157,8 @@ TColor classColour(gam::VoxelClass c)
 }
 
 void addQuad(
-	CSetOfTriangles& t, const mrpt::math::TPoint3Df& a, const mrpt::math::TPoint3Df& b,
-	const mrpt::math::TPoint3Df& c, const mrpt::math::TPoint3Df& d, const TColor& col)
+	CSetOfTriangles& t, const mrpt::math::TPoint3Df& a, const mrpt::math::TPoint3Df& b, const mrpt::math::TPoint3Df& c,
+	const mrpt::math::TPoint3Df& d, const TColor& col)
 {
 	TTriangle t1(a, b, c), t2(a, c, d);
 	for (auto* tr : {&t1, &t2})
@@ -227,8 +225,8 @@ void addFrame3D(const ViewerModel& m, COpenGLScene& scene)
 		double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
 		for (const auto& n : det.nodes)
 			if (k == 0 || n.plane_id == int(k))
-				x0 = std::min<double>(x0, n.x), x1 = std::max<double>(x1, n.x),
-				y0 = std::min<double>(y0, n.y), y1 = std::max<double>(y1, n.y);
+				x0 = std::min<double>(x0, n.x), x1 = std::max<double>(x1, n.x), y0 = std::min<double>(y0, n.y),
+				y1 = std::max<double>(y1, n.y);
 		if (x1 < x0) continue;
 		const double mg = k == 0 ? 0.5 : ga.groundOptions().pipeline.ism.plane_support_radius;
 		x0 -= mg, x1 += mg, y0 -= mg, y1 += mg;
@@ -272,8 +270,7 @@ void addRobotAndPath(const ViewerModel& m, COpenGLScene& scene)
 	{
 		auto l = CSetOfLines::Create();
 		for (size_t i = 1; i < path.size(); i++)
-			l->appendLine(
-				path[i - 1].x(), path[i - 1].y(), 0.02, path[i].x(), path[i].y(), 0.02);
+			l->appendLine(path[i - 1].x(), path[i - 1].y(), 0.02, path[i].x(), path[i].y(), 0.02);
 		l->setColor_u8(TColor(0, 200, 255));
 		l->setLineWidth(2.f);
 		scene.insert(l);
@@ -282,8 +279,7 @@ void addRobotAndPath(const ViewerModel& m, COpenGLScene& scene)
 }  // namespace
 
 void ViewerScene::build(
-	const ViewerModel& m, View v, mrpt::opengl::COpenGLScene& scene, mrpt::opengl::CCamera& cam,
-	double aspect)
+	const ViewerModel& m, View v, mrpt::opengl::COpenGLScene& scene, mrpt::opengl::CCamera& cam, double aspect)
 {
 	scene.clear();
 	auto vp = scene.getViewport();
@@ -293,8 +289,7 @@ void ViewerScene::build(
 	const auto pose = m.currentPose();
 	switch (v)
 	{
-		case View::Frame3D:
-		{
+		case View::Frame3D: {
 			vp->setCustomBackgroundColor({0.12f, 0.12f, 0.15f});
 			auto grid = CGridPlaneXY::Create(
 				float(pose.x() - 6), float(pose.x() + 6), float(pose.y() - 6), float(pose.y() + 6), 0, 1);
@@ -310,8 +305,7 @@ void ViewerScene::build(
 			cam.setZoomDistance(7.5f);
 			break;
 		}
-		case View::Map3D:
-		{
+		case View::Map3D: {
 			vp->setCustomBackgroundColor({0.12f, 0.12f, 0.15f});
 			// the 2.5D map's columns, with the ground-aware grid underneath them
 			float zlo = 0, zhi = 0;
@@ -336,12 +330,10 @@ void ViewerScene::build(
 			cam.setZoomDistance(float(std::max(box.w(), box.h()) * 1.4 * std::max(1.0, 1.33 / aspect)));
 			break;
 		}
-		case View::Grids:
-		{
+		case View::Grids: {
 			vp->setCustomBackgroundColor({0.25f, 0.25f, 0.28f});
 			const double gap = 0.05 * box.w() + 0.2;
-			const mrpt::maps::COccupancyGridMap2D* gs[3] = {
-				&m.groundAware(), &m.heightBand(), &m.octomap()};
+			const mrpt::maps::COccupancyGridMap2D* gs[3] = {&m.groundAware(), &m.heightBand(), &m.octomap()};
 			for (int i = 0; i < 3; i++) scene.insert(gridTexture(*gs[i], box, res, i * (box.w() + gap)));
 			Box all = box;
 			all.x1 = box.x1 + 2 * (box.w() + gap);
@@ -350,14 +342,12 @@ void ViewerScene::build(
 		}
 		case View::GridGroundAware:
 		case View::GridHeightBand:
-		case View::GridOctomap:
-		{
+		case View::GridOctomap: {
 			vp->setCustomBackgroundColor({0.25f, 0.25f, 0.28f});
-			const mrpt::maps::COccupancyGridMap2D& g = v == View::GridGroundAware
-														   ? static_cast<const mrpt::maps::COccupancyGridMap2D&>(m.groundAware())
-														   : v == View::GridHeightBand
-																 ? static_cast<const mrpt::maps::COccupancyGridMap2D&>(m.heightBand())
-																 : static_cast<const mrpt::maps::COccupancyGridMap2D&>(m.octomap());
+			const mrpt::maps::COccupancyGridMap2D& g =
+				v == View::GridGroundAware  ? static_cast<const mrpt::maps::COccupancyGridMap2D&>(m.groundAware())
+				: v == View::GridHeightBand ? static_cast<const mrpt::maps::COccupancyGridMap2D&>(m.heightBand())
+											: static_cast<const mrpt::maps::COccupancyGridMap2D&>(m.octomap());
 			scene.insert(gridTexture(g, box, res, 0));
 			setTopCamera(cam, box, aspect);
 			break;

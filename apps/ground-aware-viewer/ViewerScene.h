@@ -19,9 +19,9 @@ namespace gam::viewer
 {
 enum class View
 {
-	Frame3D,  ///< current step: point cloud, 2.5D voxels by class, ground plane, RRT tree
-	Map3D,	///< accumulated 2.5D map (columns), point cloud of all frames, ground-aware grid below, path
-	Grids,	///< the three grids side by side (top view)
+	Frame3D,          ///< current step: point cloud, 2.5D voxels by class, ground plane, RRT tree
+	Map3D,            ///< accumulated 2.5D map (columns), point cloud of all frames, ground-aware grid below, path
+	Grids,            ///< the three grids side by side (top view)
 	GridGroundAware,  ///< one grid, top view
 	GridHeightBand,
 	GridOctomap
@@ -45,8 +45,7 @@ class ViewerScene
 	/** Fills `scene` (cleared first) and sets `cam` for the view; `aspect` =
 	 * image width / height (for the top views' zoom). */
 	static void build(
-		const ViewerModel& m, View v, mrpt::opengl::COpenGLScene& scene, mrpt::opengl::CCamera& cam,
-		double aspect);
+		const ViewerModel& m, View v, mrpt::opengl::COpenGLScene& scene, mrpt::opengl::CCamera& cam, double aspect);
 	/** Pixel (column, row from the top) of world point (x, y) in a W x H
 	 * rendering of a single-grid top view. */
 	static void gridPixel(const ViewerModel& m, double x, double y, int W, int H, double& col, double& row);

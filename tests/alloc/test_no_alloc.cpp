@@ -93,10 +93,7 @@ void* alignedAllocOrThrow(std::size_t n, std::align_val_t al)
 class AllocCounter
 {
    public:
-	AllocCounter() : m_start(g_allocs.load())
-	{
-		t_counting = true;
-	}
+	AllocCounter() : m_start(g_allocs.load()) { t_counting = true; }
 	~AllocCounter() { t_counting = false; }
 	size_t count() const { return g_allocs.load() - m_start; }
 
@@ -111,8 +108,14 @@ void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return alloc
 void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return allocNoThrow(n); }
 void* operator new(std::size_t n, std::align_val_t a) { return alignedAllocOrThrow(n, a); }
 void* operator new[](std::size_t n, std::align_val_t a) { return alignedAllocOrThrow(n, a); }
-void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept { return alignedAlloc(n, std::size_t(a)); }
-void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept { return alignedAlloc(n, std::size_t(a)); }
+void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept
+{
+	return alignedAlloc(n, std::size_t(a));
+}
+void* operator new[](std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept
+{
+	return alignedAlloc(n, std::size_t(a));
+}
 
 void operator delete(void* p) noexcept { __libc_free(p); }
 void operator delete[](void* p) noexcept { __libc_free(p); }
@@ -206,8 +209,7 @@ CObservation3DRangeScan::Ptr syntheticFrame()
  * little) each time, so the 2.5D frame grid recenters on it. Returns the
  * largest number of allocations of one measured insertion. */
 size_t maxAllocsPerFrame(
-	CGroundAwareOccupancyGrid& grid, const std::vector<CObservation3DRangeScan::Ptr>& frames,
-	size_t& total)
+	CGroundAwareOccupancyGrid& grid, const std::vector<CObservation3DRangeScan::Ptr>& frames, size_t& total)
 {
 	int step = 0;
 	auto poseAt = [](int k) { return CPose3D(0.01 * k, 0.003 * k, 0, DEG2RAD(0.2 * k), 0, 0); };
@@ -257,8 +259,8 @@ TEST(NoAlloc, GroundAwareGridSyntheticFrameSteadyState)
 	std::vector<CObservation3DRangeScan::Ptr> frames{syntheticFrame()};
 	size_t total = 0;
 	const size_t worst = maxAllocsPerFrame(grid, frames, total);
-	std::cout << "[alloc] synthetic: " << total << " allocations in " << kMeasured
-			  << " frames (worst frame " << worst << ")\n";
+	std::cout << "[alloc] synthetic: " << total << " allocations in " << kMeasured << " frames (worst frame " << worst
+			  << ")\n";
 	EXPECT_EQ(worst, 0u) << "heap allocations per frame after warm-up; run with GAM_ALLOC_TRACE=1 to see where";
 }
 
@@ -280,7 +282,7 @@ TEST(NoAlloc, GroundAwareGridRealAndSyntheticFramesSteadyState)
 // map runs: 2.5D map, 3-sigma filter, IDW, RRT-GPD, ISM.
 TEST(NoAlloc, CorePipelineSteadyState)
 {
-	gam::GroundAwarePipeline pipeline;	// m_x = m_y = 200 at 5 cm, IDW radius 1
+	gam::GroundAwarePipeline pipeline;  // m_x = m_y = 200 at 5 cm, IDW radius 1
 
 	// A noisy floor with a 15 cm box and a gentle ramp, in a fixed point set
 	// (map frame: the sensor transform is the identity).
@@ -293,7 +295,7 @@ TEST(NoAlloc, CorePipelineSteadyState)
 		const double x = 0.3 + 3.5 * U(rng), y = -2.0 + 4.0 * U(rng);
 		float z = noise(rng);
 		if (x > 1.5 && x < 1.8 && y > 0.3 && y < 0.6) z += 0.15f;
-		if (x > 2.5 && y < -0.5) z += float(0.1 * (x - 2.5));	// ~5.7 deg ramp
+		if (x > 2.5 && y < -0.5) z += float(0.1 * (x - 2.5));  // ~5.7 deg ramp
 		xs.push_back(float(x));
 		ys.push_back(float(y));
 		zs.push_back(z);
@@ -307,7 +309,7 @@ TEST(NoAlloc, CorePipelineSteadyState)
 	size_t worst = 0;
 	for (int k = 0; k < kWarmUp + kMeasured; k++)
 	{
-		const double rx = 0.01 * k;	 // robot moves 1 cm per frame: the frame grid recentres
+		const double rx = 0.01 * k;  // robot moves 1 cm per frame: the frame grid recentres
 		frame.sensor_position = Eigen::Vector3d(rx, 0, 1.0);
 		size_t n;
 		const gam::FrameResult* r;
@@ -318,8 +320,10 @@ TEST(NoAlloc, CorePipelineSteadyState)
 		}
 		ASSERT_TRUE(r->detection.ok()) << r->detection.describe();
 		ASSERT_TRUE(r->ism.applied);
-		if (k >= kWarmUp) worst = std::max(worst, n);
-		else if (k == 0) std::cout << "[alloc] core: first frame " << n << " allocations\n";
+		if (k >= kWarmUp)
+			worst = std::max(worst, n);
+		else if (k == 0)
+			std::cout << "[alloc] core: first frame " << n << " allocations\n";
 	}
 	std::cout << "[alloc] core: worst steady-state frame " << worst << " allocations\n";
 	EXPECT_EQ(worst, 0u) << "heap allocations per frame after warm-up; run with GAM_ALLOC_TRACE=1 to see where";

@@ -43,7 +43,7 @@ mrpt::obs::CObservation3DRangeScan wallFrame()
 			for (int k = 0; k < 3; k++) d[k] = R(k, 0) * ds[0] + R(k, 1) * ds[1] + R(k, 2) * ds[2];
 			double t = 1e9;
 			if (d[0] > 1e-9) t = std::min(t, (3.0 - 0.2) / d[0]);  // wall
-			if (d[2] < -1e-9) t = std::min(t, -0.5 / d[2]);	 // floor
+			if (d[2] < -1e-9) t = std::min(t, -0.5 / d[2]);        // floor
 			o.rangeImage(r, c) = t < 5.9 ? uint16_t(std::lround(t / 0.001)) : 0;
 		}
 	return o;
@@ -74,8 +74,9 @@ T roundTrip(const T& m)
 TEST(ComparisonMaps, RegisteredForIniAndRtti)
 {
 	mrpt::maps::registerBaselineMaps();
-	for (const char* n : {"heightBandGrid", "CHeightBandOccupancyGrid", "mrpt::maps::CHeightBandOccupancyGrid",
-						  "octoMapGrid", "COctoMapGrid2D", "mrpt::maps::COctoMapGrid2D"})
+	for (const char* n :
+		 {"heightBandGrid", "CHeightBandOccupancyGrid", "mrpt::maps::CHeightBandOccupancyGrid", "octoMapGrid",
+		  "COctoMapGrid2D", "mrpt::maps::COctoMapGrid2D"})
 	{
 		std::unique_ptr<TMetricMapInitializer> d(TMetricMapInitializer::factory(n));
 		EXPECT_TRUE(d) << n;
@@ -144,13 +145,14 @@ TEST(ComparisonMaps, HeightBandSerializationAndIni)
 	EXPECT_DOUBLE_EQ(oc->octomap().getResolution(), 0.1);
 	auto o = wallFrame();
 	mm.insertObservation(o, mrpt::poses::CPose3D());
-	EXPECT_TRUE(oc->projectionOutdated());	// project_every = 0
+	EXPECT_TRUE(oc->projectionOutdated());  // project_every = 0
 	const auto back = roundTrip(*hb);
 	EXPECT_EQ(back.getRawMap(), hb->getRawMap());
 	EXPECT_DOUBLE_EQ(back.bandOptions.z_max, 1.0);
 	// Out of range in the .ini: the error names the key (MRPT's exception wrapper
 	// reformats the rest of the text).
-	mrpt::config::CConfigFileMemory bad("[map]\nheightBandGrid_count=1\n[map_heightBandGrid_00_bandOpts]\noversampling_ratio=50\n");
+	mrpt::config::CConfigFileMemory bad(
+		"[map]\nheightBandGrid_count=1\n[map_heightBandGrid_00_bandOpts]\noversampling_ratio=50\n");
 	TSetOfMetricMapInitializers inits2;
 	try
 	{

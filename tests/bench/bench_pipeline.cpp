@@ -38,7 +38,7 @@ namespace
 struct Frame
 {
 	CObservation3DRangeScan::Ptr depth;
-	CObservation2DRangeScan::Ptr scan;	// may be null
+	CObservation2DRangeScan::Ptr scan;  // may be null
 	CPose3D pose;
 };
 struct Dataset
@@ -92,7 +92,8 @@ void BM_Stage(benchmark::State& st, const Dataset* d, double gam::StageTimes::*s
 		const Frame& f = d->frames[i++ % d->frames.size()];
 		gam::SensorFrame frame;
 		gam::maps::toSensorFrame(*f.depth, f.pose, frame);
-		const gam::FrameResult& r = pipeline.process(frame, Eigen::Vector3d(f.pose.x(), f.pose.y(), f.pose.z()), lattice);
+		const gam::FrameResult& r =
+			pipeline.process(frame, Eigen::Vector3d(f.pose.x(), f.pose.y(), f.pose.z()), lattice);
 		st.SetIterationTime(r.ms.*stage / 1000.0);
 		samples += r.samples;
 		ok += r.detection.ok();
@@ -237,7 +238,9 @@ int main(int argc, char** argv)
 	// Each map once over the same frames; the ground-aware run also records its stages.
 	std::vector<StageSeries> stages(g_data.size());
 	std::vector<double> groundAwareMedian(g_data.size());
-	std::printf("\n| data | frames | px/frame | ground_aware median / p95 ms | height_band median / p95 ms | octomap median / p95 ms | height_band / ground_aware | octomap / ground_aware |\n|---|---|---|---|---|---|---|---|\n");
+	std::printf(
+		"\n| data | frames | px/frame | ground_aware median / p95 ms | height_band median / p95 ms | octomap median / "
+		"p95 ms | height_band / ground_aware | octomap / ground_aware |\n|---|---|---|---|---|---|---|---|\n");
 	for (size_t k = 0; k < g_data.size(); k++)
 	{
 		const Dataset& d = g_data[k];
@@ -248,12 +251,15 @@ int main(int argc, char** argv)
 		const auto om = timesOf<COctoMapGrid2D>(d, 1);
 		const double mga = quantile(ga, 0.5), mhb = quantile(hb, 0.5), mom = quantile(om, 0.5);
 		groundAwareMedian[k] = mga;
-		std::printf("| %s | %zu | %zux%zu | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.1fx | %.1fx |\n", d.name.c_str(),
-					d.frames.size(), size_t(d.frames[0].depth->rangeImage.cols()), size_t(d.frames[0].depth->rangeImage.rows()),
-					mga, quantile(ga, 0.95), mhb, quantile(hb, 0.95), mom, quantile(om, 0.95), mhb / mga, mom / mga);
+		std::printf(
+			"| %s | %zu | %zux%zu | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.1fx | %.1fx |\n", d.name.c_str(),
+			d.frames.size(), size_t(d.frames[0].depth->rangeImage.cols()), size_t(d.frames[0].depth->rangeImage.rows()),
+			mga, quantile(ga, 0.95), mhb, quantile(hb, 0.95), mom, quantile(om, 0.95), mhb / mga, mom / mga);
 	}
 
-	std::printf("\nground_aware per stage (the map's own timers), median / p95 ms:\n\n| data | 2.5D projection | 3-sigma filter + IDW | RRT-GPD | ISM | grid update | whole frame |\n|---|---|---|---|---|---|---|\n");
+	std::printf(
+		"\nground_aware per stage (the map's own timers), median / p95 ms:\n\n| data | 2.5D projection | 3-sigma "
+		"filter + IDW | RRT-GPD | ISM | grid update | whole frame |\n|---|---|---|---|---|---|---|\n");
 	auto mp = [](const std::vector<double>& v) {
 		char b[64];
 		std::snprintf(b, sizeof b, "%.3f / %.3f", quantile(v, 0.5), quantile(v, 0.95));
@@ -262,9 +268,9 @@ int main(int argc, char** argv)
 	for (size_t k = 0; k < g_data.size(); k++)
 	{
 		const StageSeries& t = stages[k];
-		std::printf("| %s | %s | %s | %s | %s | %s | %s |\n", g_data[k].name.c_str(), mp(t.projection).c_str(),
-					mp(t.outliers).c_str(), mp(t.ground).c_str(), mp(t.ism).c_str(), mp(t.update).c_str(),
-					mp(t.total).c_str());
+		std::printf(
+			"| %s | %s | %s | %s | %s | %s | %s |\n", g_data[k].name.c_str(), mp(t.projection).c_str(),
+			mp(t.outliers).c_str(), mp(t.ground).c_str(), mp(t.ism).c_str(), mp(t.update).c_str(), mp(t.total).c_str());
 	}
 
 	if (fullOctomapFrames > 0)
@@ -272,13 +278,17 @@ int main(int argc, char** argv)
 		// The run's octomap inserts every 4th pixel of every 4th row (decimation 4,
 		// ground-aware-mapper.ini): 1/16 of what the ground-aware grid reads. This
 		// times it on every pixel too, the same input as the ground-aware grid.
-		std::printf("\noctomap on every pixel (decimation 1), first %d frames:\n\n| data | octomap (every pixel) median / p95 ms | ground_aware median ms | ratio |\n|---|---|---|---|\n", fullOctomapFrames);
+		std::printf(
+			"\noctomap on every pixel (decimation 1), first %d frames:\n\n| data | octomap (every pixel) median / p95 "
+			"ms | ground_aware median ms | ratio |\n|---|---|---|---|\n",
+			fullOctomapFrames);
 		for (size_t k = 0; k < g_data.size(); k++)
 		{
 			const auto om = timesOf<COctoMapGrid2D>(
 				g_data[k], 1, size_t(fullOctomapFrames), [](COctoMapGrid2D& m) { m.octoOptions.decimation = 1; });
-			std::printf("| %s | %.1f / %.1f | %.2f | %.0fx |\n", g_data[k].name.c_str(), quantile(om, 0.5),
-						quantile(om, 0.95), groundAwareMedian[k], quantile(om, 0.5) / groundAwareMedian[k]);
+			std::printf(
+				"| %s | %.1f / %.1f | %.2f | %.0fx |\n", g_data[k].name.c_str(), quantile(om, 0.5), quantile(om, 0.95),
+				groundAwareMedian[k], quantile(om, 0.5) / groundAwareMedian[k]);
 		}
 	}
 	return 0;

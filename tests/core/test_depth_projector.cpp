@@ -69,10 +69,7 @@ Eigen::Matrix3d pitchDown(double deg)
 	// Rotation about +Y by +deg maps +X to (cos, 0, -sin): looking down.
 	return Eigen::AngleAxisd(deg2rad(deg), Eigen::Vector3d::UnitY()).toRotationMatrix();
 }
-Eigen::Matrix3d yaw(double deg)
-{
-	return Eigen::AngleAxisd(deg2rad(deg), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-}
+Eigen::Matrix3d yaw(double deg) { return Eigen::AngleAxisd(deg2rad(deg), Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
 
 /** The cell `idx` must contain (x, y), up to a tolerance for float rounding at
  * the cell borders. */
@@ -89,8 +86,8 @@ void expectInCell(const GridGeometry& g, uint32_t idx, double x, double y, doubl
 /** Projects each listed pixel alone (every 5th row and column) and compares it
  * with the analytic point R * (D * ray) + t. */
 void checkPixelsOneByOne(
-	const Image& img, bool isDepth, const RigidTransform& T, const Eigen::Matrix3d& R,
-	const Eigen::Vector3d& t, const ElevationGrid& grid, int* checked)
+	const Image& img, bool isDepth, const RigidTransform& T, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+	const ElevationGrid& grid, int* checked)
 {
 	const PinholeIntrinsics K = camera();
 	DepthProjector proj;
@@ -145,7 +142,7 @@ TEST(DepthProjector, RayLutFollowsMrptConvention)
 			EXPECT_NEAR(k.x(), (31.5 - c) / 50.0, 1e-6);
 			EXPECT_NEAR(k.y(), (23.5 - r) / 50.0, 1e-6);
 		}
-	EXPECT_EQ(out.size(), 0u);	// an all-zero image bins nothing
+	EXPECT_EQ(out.size(), 0u);  // an all-zero image bins nothing
 }
 
 TEST(DepthProjector, WallAtThreeMetresLandsInItsColumn)
@@ -155,7 +152,7 @@ TEST(DepthProjector, WallAtThreeMetresLandsInItsColumn)
 	const Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
 	const Eigen::Vector3d t(0, 0, 0.5);
 	const RigidTransform T = pose(R, t);
-	ElevationGrid grid;	 // -5..5, 0.05
+	ElevationGrid grid;  // -5..5, 0.05
 	const Image img = wallDepthImage(3.02);
 
 	DepthProjector proj;
@@ -183,7 +180,7 @@ TEST(DepthProjector, WallAtThreeMetresLandsInItsColumn)
 	for (int c = 0; c < W; c++)
 	{
 		const double y = 3.02 * (31.5 - c) / 50, fy = (y + 5) / 0.05;
-		ASSERT_GT(std::abs(fy - std::round(fy)), 0.01);	// no pixel on a cell border
+		ASSERT_GT(std::abs(fy - std::round(fy)), 0.01);  // no pixel on a cell border
 		expectedCount[size_t(std::floor(fy))] += H;
 	}
 	for (int cy = 0; cy < g.ny; cy++)
@@ -261,8 +258,7 @@ TEST(DepthProjector, FloorFromPitchedCameraLandsAtZeroHeight)
 		const Eigen::Vector3d P = t + (1.0 / -w.z()) * w;
 		EXPECT_TRUE(grid.cell(grid.geometry().ix(P.x()), grid.geometry().iy(P.y())).observed());
 		// Nothing is closer to the camera than that row, in x.
-		for (uint32_t idx : grid.observedCells())
-			EXPECT_GE(grid.geometry().cx(int(idx % 200u)), P.x() - 0.06);
+		for (uint32_t idx : grid.observedCells()) EXPECT_GE(grid.geometry().cx(int(idx % 200u)), P.x() - 0.06);
 	}
 	int checked = 0;
 	checkPixelsOneByOne(img, true, T, R, t, grid, &checked);
@@ -295,7 +291,7 @@ TEST(DepthProjector, RangeModeUsesEuclideanRange)
 	one.at(0, 0) = img.at(0, 0);
 	out.clear();
 	ASSERT_EQ(proj.project(one.view(true), K, T, f, grid, out), 1u);
-	const double xr = 3.02 * pixelRay(K, 0, 0).norm();	// 3.84 m
+	const double xr = 3.02 * pixelRay(K, 0, 0).norm();  // 3.84 m
 	EXPECT_EQ(int(out.cells()[0] % 200u), int(std::floor((xr + 5) / 0.05)));
 
 	// Range limits apply to the range along the ray in this mode: a wall at
@@ -369,7 +365,7 @@ TEST(DepthProjector, HeightBandAndRangeLimits)
 		const double z = 0.5 + 3.02 * (23.5 - r) / 50;
 		if (z >= 0 && z <= 1) rowsIn++;
 	}
-	ASSERT_EQ(rowsIn, 16u);	 // r = 16..31
+	ASSERT_EQ(rowsIn, 16u);  // r = 16..31
 	ProjectionFilter f;
 	f.z_min = 0.0f;
 	f.z_max = 1.0f;
@@ -483,8 +479,7 @@ TEST(DepthProjector, RejectsInconsistentInputs)
 
 	// rangeUnits.
 	for (float units : {0.0f, -0.001f, float(NAN)})
-		EXPECT_THROW(proj.project(img.view(true, units), camera(), T, f, grid, out), std::invalid_argument)
-			<< units;
+		EXPECT_THROW(proj.project(img.view(true, units), camera(), T, f, grid, out), std::invalid_argument) << units;
 
 	// Non-finite pose.
 	RigidTransform bad = T;
@@ -494,7 +489,7 @@ TEST(DepthProjector, RejectsInconsistentInputs)
 	bad.R(1, 2) = INFINITY;
 	EXPECT_THROW(proj.project(img.view(), camera(), bad, f, grid, out), std::invalid_argument);
 
-	EXPECT_EQ(out.size(), 0u);	// nothing was binned by the failed calls
+	EXPECT_EQ(out.size(), 0u);  // nothing was binned by the failed calls
 	EXPECT_NO_THROW(proj.project(img.view(), camera(), T, f, grid, out));
 	EXPECT_EQ(out.size(), size_t(W * H));
 }

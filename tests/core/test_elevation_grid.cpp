@@ -23,7 +23,7 @@ TEST(GridGeometry, IndexingAndCentres)
 	EXPECT_EQ(g.ix(-1.76), 0);
 	EXPECT_EQ(g.ix(-1.5), 1);
 	EXPECT_EQ(g.ix(1.99), 7);
-	EXPECT_EQ(g.ix(-2.01), -1);	 // floor, not truncation
+	EXPECT_EQ(g.ix(-2.01), -1);  // floor, not truncation
 	EXPECT_EQ(g.iy(2.3), 2);
 	EXPECT_DOUBLE_EQ(g.cx(0), -1.75);
 	EXPECT_DOUBLE_EQ(g.cy(3), 2.75);
@@ -68,7 +68,7 @@ TEST(ElevationGrid, CellStatisticsByHand)
 	BinnedPoints b;
 	for (float z : {0.1f, 0.2f, 0.6f}) grid.binPoint(1.5, 2.5, z, b);
 	grid.binPoint(3.5, 0.5, -1.0f, b);
-	OutlierFilterParams f;	// enabled, but 3 samples < min_count
+	OutlierFilterParams f;  // enabled, but 3 samples < min_count
 	EXPECT_EQ(grid.insert(b, f), 4u);
 	EXPECT_EQ(grid.observedCount(), 2u);
 
@@ -152,7 +152,7 @@ TEST(ElevationGridFilter, ThreeSigmaRemovesTheOutlier)
 	ElevationGrid grid(makeGeometry(0, 0, 1.0, 4, 4));
 	BinnedPoints b;
 	binOutlierCase(grid, oc, b);
-	OutlierFilterParams f;	// defaults: enabled, 3 sigma, min_count 4
+	OutlierFilterParams f;  // defaults: enabled, 3 sigma, min_count 4
 	EXPECT_EQ(grid.insert(b, f), 50u);
 
 	const ElevationCell& c = grid.cell(2, 2);
@@ -322,7 +322,7 @@ TEST(ElevationGridIdw, HandComputedWeightedAverages)
 	// (5,5): (4,5) d=1 w=1, (6,5) d=1 w=1, (6,6) d=sqrt2 w=1/2
 	EXPECT_NEAR(grid.cell(5, 5).z_idw, (1 * 1.0 + 1 * 2.0 + 0.5 * 3.0) / 2.5, 1e-5);  // 1.8
 	// (5,6): (4,5) w=1/2, (6,5) w=1/2, (6,6) w=1
-	EXPECT_NEAR(grid.cell(5, 6).z_idw, (0.5 * 1.0 + 0.5 * 2.0 + 1 * 3.0) / 2.0, 1e-5);	// 2.25
+	EXPECT_NEAR(grid.cell(5, 6).z_idw, (0.5 * 1.0 + 0.5 * 2.0 + 1 * 3.0) / 2.0, 1e-5);  // 2.25
 	// min_neighbours respected: (7,6) and (5,4) see only two observed cells.
 	EXPECT_TRUE(std::isnan(grid.cell(7, 6).z_idw));
 	EXPECT_TRUE(std::isnan(grid.cell(5, 4).z_idw));
@@ -377,8 +377,7 @@ TEST(ElevationGridIdw, LargerRadiusAndObservationReplacesEstimate)
 	p.min_neighbours = 3;
 	grid.interpolateIdw(p);
 	// (4,7): (4,5) d=2 w=1/4 z=1; (6,5) d=sqrt8 w=1/8 z=2; (6,6) d=sqrt5 w=1/5 z=3
-	EXPECT_NEAR(
-		grid.cell(4, 7).z_idw, (0.25 * 1 + 0.125 * 2 + 0.2 * 3) / (0.25 + 0.125 + 0.2), 1e-5);
+	EXPECT_NEAR(grid.cell(4, 7).z_idw, (0.25 * 1 + 0.125 * 2 + 0.2 * 3) / (0.25 + 0.125 + 0.2), 1e-5);
 	// (8,8): only (6,6) (d=sqrt8) within 2 cells
 	EXPECT_TRUE(std::isnan(grid.cell(8, 8).z_idw));
 	// (3,4) is within reach of (4,5) d=sqrt2 and (6,5)? dx=3 > 2: no. -> NaN

@@ -97,17 +97,14 @@ struct FloorWallBox
 {
 	static bool isWall(double x, double y) { return inRect(x, y, 2.5, 2.6, -3, 3); }
 	static bool isBox(double x, double y) { return inRect(x, y, 1.0, 1.5, 0.5, 1.0); }
-	static bool isFloor(double x, double y)
-	{
-		return inRect(x, y, -3, 2.5, -3, 3) && !isBox(x, y);
-	}
+	static bool isFloor(double x, double y) { return inRect(x, y, -3, 2.5, -3, 3) && !isBox(x, y); }
 };
 
 /** Samples vertical columns (walls, box sides): every cell centre in the
  * rectangle gets points at heights z0, z0+dz, ..., z1. */
 inline void sampleColumns(
-	const gam::ElevationGrid& grid, double x0, double x1, double y0, double y1, double z0,
-	double z1, double dz, gam::BinnedPoints& out)
+	const gam::ElevationGrid& grid, double x0, double x1, double y0, double y1, double z0, double z1, double dz,
+	gam::BinnedPoints& out)
 {
 	const gam::GridGeometry& g = grid.geometry();
 	for (int cy = 0; cy < g.ny; cy++)
@@ -129,18 +126,17 @@ inline void insertAll(gam::ElevationGrid& grid, const gam::BinnedPoints& b)
 inline void buildFloorWallBox(gam::ElevationGrid& grid, std::mt19937& rng)
 {
 	gam::BinnedPoints b;
-	sampleSurfaceIf(grid, FloorWallBox::isFloor, [](double, double) { return 0.0; }, 3, 0.003, rng, b);
-	sampleSurfaceIf(grid, FloorWallBox::isBox, [](double, double) { return 0.4; }, 3, 0.003, rng, b);
+	sampleSurfaceIf(
+		grid, FloorWallBox::isFloor, [](double, double) { return 0.0; }, 3, 0.003, rng, b);
+	sampleSurfaceIf(
+		grid, FloorWallBox::isBox, [](double, double) { return 0.4; }, 3, 0.003, rng, b);
 	sampleColumns(grid, 2.5, 2.6, -3, 3, 0.0, 2.0, 0.05, b);
 	insertAll(grid, b);
 }
 
 /** Scene 2: floor z = 0 for x in [-4, 1), then a 6 deg ramp up to x = 3,
  * y in [-3, 3). */
-inline double rampHeight(double x, double deg = 6.0)
-{
-	return x < 1.0 ? 0.0 : std::tan(deg2rad(deg)) * (x - 1.0);
-}
+inline double rampHeight(double x, double deg = 6.0) { return x < 1.0 ? 0.0 : std::tan(deg2rad(deg)) * (x - 1.0); }
 inline void buildRamp(gam::ElevationGrid& grid, std::mt19937& rng)
 {
 	gam::BinnedPoints b;

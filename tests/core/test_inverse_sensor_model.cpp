@@ -43,7 +43,7 @@ GroundDetection handDetection(const Plane& pl, GroundDetection::Status s = Groun
 	d.plane_support.push_back(100);
 	return d;
 }
-const Plane kFloor{0, 0, 1, 0};	 // z = 0
+const Plane kFloor{0, 0, 1, 0};  // z = 0
 
 /** Consistency of evidence() and evidenceCells(). */
 void checkEvidenceBookkeeping(const InverseSensorModel& ism)
@@ -64,27 +64,27 @@ void checkEvidenceBookkeeping(const InverseSensorModel& ism)
 TEST(IsmFormulas, VoxelDensity)
 {
 	// N / (d_r^2 * max(span, d_r))
-	EXPECT_NEAR(ism::voxelDensity(10, 0.2, 0.05), 10 / (0.0025 * 0.2), 1e-6);	// 20000
-	EXPECT_NEAR(ism::voxelDensity(5, 0.01, 0.05), 40000.0, 1e-6);  // span < d_r -> d_r
+	EXPECT_NEAR(ism::voxelDensity(10, 0.2, 0.05), 10 / (0.0025 * 0.2), 1e-6);  // 20000
+	EXPECT_NEAR(ism::voxelDensity(5, 0.01, 0.05), 40000.0, 1e-6);              // span < d_r -> d_r
 	EXPECT_NEAR(ism::voxelDensity(1, 0.0, 0.1), 1000.0, 1e-9);
 	EXPECT_EQ(ism::voxelDensity(0, 0.3, 0.05), 0.0);
 }
 
 TEST(IsmFormulas, DensityConfidence)
 {
-	const IsmParams p;	// K_n = 0.0005, d_min = 3
+	const IsmParams p;  // K_n = 0.0005, d_min = 3
 	EXPECT_DOUBLE_EQ(p.K_n, 0.0005);
 	EXPECT_DOUBLE_EQ(p.d_min, 3.0);
-	EXPECT_NEAR(ism::densityConfidence(6000, p), 0.5, 1e-12);  // K_n rho = d_min
-	EXPECT_NEAR(ism::densityConfidence(10000, p), 0.8807970779778823, 1e-12);	 // 1/(1+e^-2)
-	EXPECT_NEAR(ism::densityConfidence(0, p), 0.04742587317756678, 1e-12);  // 1/(1+e^3)
-	EXPECT_NEAR(ism::densityConfidence(2000, p), 0.11920292202211755, 1e-12);	 // 1/(1+e^2)
+	EXPECT_NEAR(ism::densityConfidence(6000, p), 0.5, 1e-12);                  // K_n rho = d_min
+	EXPECT_NEAR(ism::densityConfidence(10000, p), 0.8807970779778823, 1e-12);  // 1/(1+e^-2)
+	EXPECT_NEAR(ism::densityConfidence(0, p), 0.04742587317756678, 1e-12);     // 1/(1+e^3)
+	EXPECT_NEAR(ism::densityConfidence(2000, p), 0.11920292202211755, 1e-12);  // 1/(1+e^2)
 	EXPECT_GT(ism::densityConfidence(1e6, p), 0.999999);
 }
 
 TEST(IsmFormulas, ObstacleProbability)
 {
-	const IsmParams p;	// K_m = 0.8
+	const IsmParams p;  // K_m = 0.8
 	EXPECT_NEAR(ism::obstacleProbability(0.0, p), 0.5, 1e-12);
 	EXPECT_NEAR(ism::obstacleProbability(0.5, p), 0.7, 1e-12);
 	EXPECT_NEAR(ism::obstacleProbability(1.0, p), 0.9, 1e-12);
@@ -93,7 +93,7 @@ TEST(IsmFormulas, ObstacleProbability)
 
 TEST(IsmFormulas, GroundProbability)
 {
-	const IsmParams p;	// K_g = 0.3, sigma2 = 0.02
+	const IsmParams p;  // K_g = 0.3, sigma2 = 0.02
 	EXPECT_NEAR(ism::groundProbability(0.0, p), 0.2, 1e-12);
 	// d = 0.1: exp(-0.01 / 0.04) = exp(-0.25) = 0.7788007830714049
 	EXPECT_NEAR(ism::groundProbability(0.1, p), 0.5 - 0.3 * 0.7788007830714049, 1e-12);
@@ -155,11 +155,10 @@ TEST(IsmParamsTest, ValidateAndDefaults)
 
 TEST(InverseSensorModel, GroundBandNoiseModel)
 {
-	InverseSensorModel ism;	 // d_pth 0.03, c0 0.0012, c2 0.0019, 3 sigmas
+	InverseSensorModel ism;  // d_pth 0.03, c0 0.0012, c2 0.0019, 3 sigmas
 	// Sensor 1 m above the floor, voxel on the floor 3 m ahead: r^2 = 10.
 	const double r = std::sqrt(10.0);
-	EXPECT_NEAR(
-		ism.groundBand({0, 0, 1}, 1.0, 3, 0, 0), 0.03 + 3 * (0.0012 + 0.0019 * 10) * (1 / r), 1e-12);
+	EXPECT_NEAR(ism.groundBand({0, 0, 1}, 1.0, 3, 0, 0), 0.03 + 3 * (0.0012 + 0.0019 * 10) * (1 / r), 1e-12);
 	// 0.049163...
 	EXPECT_NEAR(ism.groundBand({0, 0, 1}, 1.0, 3, 0, 0), 0.0491627, 1e-6);
 	// The sign of the sensor height does not matter.
@@ -172,7 +171,7 @@ TEST(InverseSensorModel, GroundBandNoiseModel)
 	EXPECT_GT(ism.groundBand({0, 0, 1}, 1.0, 4.5, 0, 0), ism.groundBand({0, 0, 1}, 1.0, 1.5, 0, 0));
 
 	IsmParams p;
-	p.noise_sigmas = 0;	 // the paper's fixed band
+	p.noise_sigmas = 0;  // the paper's fixed band
 	ism.setParams(p);
 	EXPECT_DOUBLE_EQ(ism.groundBand({0, 0, 1}, 1.0, 3, 0, 0), 0.03);
 	p.noise_sigmas = 2;
@@ -186,11 +185,11 @@ TEST(InverseSensorModel, GroundBandNoiseModel)
 
 TEST(InverseSensorModel, ClassifyAgainstAPlane)
 {
-	InverseSensorModel ism;	 // robot_height 1.8
+	InverseSensorModel ism;  // robot_height 1.8
 	const double band = 0.05;
 	double d = 99;
 	EXPECT_EQ(ism.classify(cellOf({-0.01f, 0.02f}), 1, 1, kFloor, band, d), VoxelClass::Ground);
-	EXPECT_NEAR(d, 0.005, 1e-6);  // the mean's distance
+	EXPECT_NEAR(d, 0.005, 1e-6);                                                           // the mean's distance
 	EXPECT_EQ(ism.classify(cellOf({0.049f}), 1, 1, kFloor, band, d), VoxelClass::Ground);  // inside the band
 	EXPECT_EQ(ism.classify(cellOf({-0.049f}), 1, 1, kFloor, band, d), VoxelClass::Ground);
 	EXPECT_EQ(ism.classify(cellOf({0.0f, 0.3f}), 1, 1, kFloor, band, d), VoxelClass::Obstacle);
@@ -229,8 +228,8 @@ TEST(InverseSensorModel, ClassifyAgainstAPlane)
 namespace
 {
 // Frame of test ISM-1 (grid -5..5 m, 5 cm). Sensor at (0, 0, 1), ground z = 0.
-bool isBox(double x, double y) { return inRect(x, y, 1.2, 1.3, 0.5, 0.6); }	 // 2x2 cells
-bool isHole(double x, double y) { return inRect(x, y, 1.5, 1.6, -0.5, -0.4); }	 // 2x2 cells
+bool isBox(double x, double y) { return inRect(x, y, 1.2, 1.3, 0.5, 0.6); }     // 2x2 cells
+bool isHole(double x, double y) { return inRect(x, y, 1.5, 1.6, -0.5, -0.4); }  // 2x2 cells
 bool isFloor(double x, double y) { return inRect(x, y, 0.5, 2.0, -1.0, 1.0) && !isBox(x, y) && !isHole(x, y); }
 bool isBeam(double x, double y) { return inRect(x, y, 0.7, 0.8, 1.2, 1.3); }
 bool isShelf(double x, double y) { return inRect(x, y, 0.7, 0.8, -1.3, -1.2); }
@@ -242,10 +241,11 @@ ElevationGrid sceneFrame()
 	std::mt19937 rng(1);
 	BinnedPoints b;
 	auto zero = [](double, double) { return 0.0; };
-	gamtest::sampleSurfaceIf(grid, isFloor, zero, 2, 0.0, rng, b);	// 4 pts at z = 0
-	gamtest::sampleColumns(grid, 1.2, 1.3, 0.5, 0.6, 0.0, 0.4, 0.1, b);	// 5 pts, span 0.4
-	gamtest::sampleSurfaceIf(grid, isHole, [](double, double) { return -0.3; }, 1, 0.0, rng, b);
-	gamtest::sampleColumns(grid, 0.7, 0.8, 1.2, 1.3, 1.9, 2.3, 0.1, b);	 // above 1.8
+	gamtest::sampleSurfaceIf(grid, isFloor, zero, 2, 0.0, rng, b);       // 4 pts at z = 0
+	gamtest::sampleColumns(grid, 1.2, 1.3, 0.5, 0.6, 0.0, 0.4, 0.1, b);  // 5 pts, span 0.4
+	gamtest::sampleSurfaceIf(
+		grid, isHole, [](double, double) { return -0.3; }, 1, 0.0, rng, b);
+	gamtest::sampleColumns(grid, 0.7, 0.8, 1.2, 1.3, 1.9, 2.3, 0.1, b);    // above 1.8
 	gamtest::sampleColumns(grid, 0.7, 0.8, -1.3, -1.2, 1.0, 2.5, 0.1, b);  // 16 pts, span 1.5
 	gamtest::sampleColumns(grid, 4.2, 4.3, 0.0, 0.1, 0.0, 0.4, 0.1, b);
 	gamtest::insertAll(grid, b);
@@ -258,14 +258,14 @@ TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
 	const ElevationGrid frame = sceneFrame();
 	const GridGeometry& g = frame.geometry();
 	IsmParams p;
-	p.min_obstacle_points = 1;	// the hole cells have one sample each (see LoneSamples... below)
+	p.min_obstacle_points = 1;  // the hole cells have one sample each (see LoneSamples... below)
 	InverseSensorModel ism(p);
 	IsmStats st;
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 4.0, st);  // max range 4 m
 	EXPECT_TRUE(st.applied);
 
-	const double pBox = handObstacleP(5, 0.4, 0.05);	 // rho 5000: 0.651016
-	const double pHole = handObstacleP(1, 0.0, 0.05);	 // rho 8000: 0.792423
+	const double pBox = handObstacleP(5, 0.4, 0.05);   // rho 5000: 0.651016
+	const double pHole = handObstacleP(1, 0.0, 0.05);  // rho 8000: 0.792423
 	const double pShelf = handObstacleP(16, 1.5, 0.05);
 	EXPECT_NEAR(pBox, 0.5 + 0.4 / (1 + std::exp(0.5)), 1e-12);
 	EXPECT_NEAR(pHole, 0.5 + 0.4 / (1 + std::exp(-1.0)), 1e-12);
@@ -282,7 +282,7 @@ TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
 			{
 				nFloor++;
 				EXPECT_EQ(k, VoxelClass::Ground) << x << "," << y;
-				EXPECT_FLOAT_EQ(e, 0.2f) << x << "," << y;	// 0.5 - K_g: on the plane
+				EXPECT_FLOAT_EQ(e, 0.2f) << x << "," << y;  // 0.5 - K_g: on the plane
 			}
 			else if (isBox(x, y))
 			{
@@ -357,7 +357,7 @@ TEST(InverseSensorModel, GroundEvidenceFollowsPlaneDistance)
 	const GridGeometry& g = frame.geometry();
 	const size_t i = g.index(g.ix(1.0), g.iy(0.0));
 	EXPECT_EQ(ism.classes()[i], VoxelClass::Ground);
-	EXPECT_NEAR(ism.evidence()[i], 0.5 - 0.3 * std::exp(-0.0001 / 0.04), 1e-6);	 // 0.200749
+	EXPECT_NEAR(ism.evidence()[i], 0.5 - 0.3 * std::exp(-0.0001 / 0.04), 1e-6);  // 0.200749
 }
 
 TEST(InverseSensorModel, NoPlaneNeverInventsObstacles)
@@ -369,8 +369,9 @@ TEST(InverseSensorModel, NoPlaneNeverInventsObstacles)
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	ASSERT_FALSE(ism.evidenceCells().empty());
 
-	for (auto s : {GroundDetection::Status::EmptyGrid, GroundDetection::Status::NoValidSeed,
-				   GroundDetection::Status::TooFewNodes, GroundDetection::Status::NoConsensus})
+	for (auto s :
+		 {GroundDetection::Status::EmptyGrid, GroundDetection::Status::NoValidSeed,
+		  GroundDetection::Status::TooFewNodes, GroundDetection::Status::NoConsensus})
 	{
 		// Even with a plane in the result, a failed detection produces nothing.
 		ism.compute(frame, handDetection(kFloor, s), {0, 0, 1}, 5.0, st);
@@ -391,7 +392,8 @@ TEST(InverseSensorModel, NoPlaneNeverInventsObstacles)
 	ElevationGrid table;
 	std::mt19937 rng(4);
 	BinnedPoints b;
-	gamtest::sampleSurface(table, -1, 1, -1, 1, [](double, double) { return 0.9; }, 2, 0.002, rng, b);
+	gamtest::sampleSurface(
+		table, -1, 1, -1, 1, [](double, double) { return 0.9; }, 2, 0.002, rng, b);
 	gamtest::insertAll(table, b);
 	RrtGroundDetector det;
 	GroundDetection out;
@@ -414,11 +416,14 @@ ElevationGrid stepFrame(int lowerSamples = 1)
 	ElevationGrid grid;
 	std::mt19937 rng(1);
 	BinnedPoints b;
-	gamtest::sampleSurfaceIf(grid, isUpper, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
-	gamtest::sampleSurfaceIf(grid, isPatch, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
+	gamtest::sampleSurfaceIf(
+		grid, isUpper, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
+	gamtest::sampleSurfaceIf(
+		grid, isPatch, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
 	// lowerSamples samples per lower cell, at -0.30, -0.31, ...
 	for (int k = 0; k < lowerSamples; k++)
-		gamtest::sampleSurfaceIf(grid, isLower, [k](double, double) { return -0.3 - 0.01 * k; }, 1, 0.0, rng, b);
+		gamtest::sampleSurfaceIf(
+			grid, isLower, [k](double, double) { return -0.3 - 0.01 * k; }, 1, 0.0, rng, b);
 	gamtest::insertAll(grid, b);
 	return grid;
 }
@@ -468,8 +473,7 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 		}
 	// The upper floor is untouched.
 	for (int cy = g.iy(-0.45); cy <= g.iy(0.45); cy++)
-		for (int cx = g.ix(0.55); cx <= g.ix(1.45); cx++)
-			EXPECT_FLOAT_EQ(ism.evidence()[g.index(cx, cy)], 0.2f);
+		for (int cx = g.ix(0.55); cx <= g.ix(1.45); cx++) EXPECT_FLOAT_EQ(ism.evidence()[g.index(cx, cy)], 0.2f);
 	// Nothing is marked where no ray went: beside the lower floor, or behind it.
 	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.3), g.iy(1.0))], 0.5f);
 	EXPECT_EQ(ism.evidence()[g.index(g.ix(3.6), g.iy(0.0))], 0.5f);
@@ -494,7 +498,10 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	EXPECT_EQ(st.drop, 18u * 20u);
 	for (int cx = g.ix(1.5); cx < g.ix(2.6); cx++)
 	{
-		if (!isPatch(g.cx(cx), 0.025)) { EXPECT_EQ(ism.evidence()[g.index(cx, g.iy(0.025))], 0.5f); }
+		if (!isPatch(g.cx(cx), 0.025))
+		{
+			EXPECT_EQ(ism.evidence()[g.index(cx, g.iy(0.025))], 0.5f);
+		}
 	}
 	EXPECT_NEAR(ism.evidence()[g.index(g.ix(3.0), g.iy(0.0))], pDrop, 1e-6);
 }
@@ -532,7 +539,7 @@ TEST(InverseSensorModel, NeutralEvidenceIsNeverListed)
 	IsmParams p;
 	p.K_g = 0;
 	p.K_m = 0;
-	p.drop_ray_min_points = 1;	// the lower cells have one sample: let them cast rays
+	p.drop_ray_min_points = 1;  // the lower cells have one sample: let them cast rays
 	p.min_obstacle_points = 1;
 	InverseSensorModel ism(p);
 	IsmStats st;
@@ -581,8 +588,14 @@ TEST(InverseSensorModel, RampIsGroundOnlyWithLocalPlanes)
 				n++;
 				ng += ism.classes()[idx] == VoxelClass::Ground;
 				no += ism.classes()[idx] == VoxelClass::Obstacle;
-				if (ism.classes()[idx] == VoxelClass::Ground) { EXPECT_LT(ism.evidence()[idx], 0.5f); }
-				if (ism.classes()[idx] == VoxelClass::Obstacle) { EXPECT_GT(ism.evidence()[idx], 0.5f); }
+				if (ism.classes()[idx] == VoxelClass::Ground)
+				{
+					EXPECT_LT(ism.evidence()[idx], 0.5f);
+				}
+				if (ism.classes()[idx] == VoxelClass::Obstacle)
+				{
+					EXPECT_GT(ism.evidence()[idx], 0.5f);
+				}
 			}
 			else if (x < 0.8 && x > -2.0 && std::abs(y) < 2.0)
 			{
@@ -599,8 +612,7 @@ TEST(InverseSensorModel, RampIsGroundOnlyWithLocalPlanes)
 	fractions(true, g1, o1, f1);
 	fractions(false, g0, o0, f0);
 	std::cout << "ISM ramp cells: local planes -> " << 100 * g1 << "% ground, " << 100 * o1
-			  << "% obstacle; single plane -> " << 100 * g0 << "% ground, " << 100 * o0
-			  << "% obstacle" << std::endl;
+			  << "% obstacle; single plane -> " << 100 * g0 << "% ground, " << 100 * o0 << "% obstacle" << std::endl;
 	EXPECT_GT(g1, 0.95);
 	EXPECT_LT(o1, 0.05);
 	EXPECT_GT(o0, 0.95);

@@ -91,7 +91,7 @@ TEST(Pipeline, DepthImageOfFloorAndBoxToEvidence)
 	frame.sensor_position = camPos;
 
 	PipelineParams params;
-	params.m_x = params.m_y = 240;	// x, y in [-6, 6): everything the camera sees up to 4.5 m
+	params.m_x = params.m_y = 240;  // x, y in [-6, 6): everything the camera sees up to 4.5 m
 	GroundAwarePipeline pipeline(params);
 	const FrameResult& res = pipeline.process(frame, Eigen::Vector3d(0, 0, 0), GridLattice{0, 0, 0.05});
 	ASSERT_TRUE(res.valid);
@@ -160,7 +160,8 @@ TEST(Pipeline, EveryParameterHasOneKeyAndOneRange)
 	});
 	EXPECT_EQ(keys.size(), n);
 	// Paper Table I names are the keys.
-	for (const char* k : {"K", "N_th", "E_th", "s_x", "s_y", "m_x", "m_y", "d_n", "d_pth", "K_g", "sigma2", "K_n", "d_min", "K_m"})
+	for (const char* k :
+		 {"K", "N_th", "E_th", "s_x", "s_y", "m_x", "m_y", "d_n", "d_pth", "K_g", "sigma2", "K_n", "d_min", "K_m"})
 		EXPECT_EQ(keys.count(k), 1u) << k;
 	EXPECT_NO_THROW(defaults.validate());
 }
@@ -191,13 +192,12 @@ TEST(Pipeline, ParametersAreCheckedWhenSetNotPerFrame)
 	p.rrt.neighbourhood_x = 4;
 	EXPECT_THROW(pipeline.setParams(p), std::invalid_argument);
 	p = PipelineParams{};
-	p.m_x = p.m_y = 20000;	// 4e8 cells > the 2.5D map's 67M-cell limit
+	p.m_x = p.m_y = 20000;  // 4e8 cells > the 2.5D map's 67M-cell limit
 	EXPECT_THROW(pipeline.setParams(p), std::invalid_argument);
 
 	// A bad input frame is an error too, not silent garbage.
 	SensorFrame empty;
-	EXPECT_THROW(
-		pipeline.process(empty, Eigen::Vector3d(NAN, 0, 0), GridLattice{}), std::invalid_argument);
+	EXPECT_THROW(pipeline.process(empty, Eigen::Vector3d(NAN, 0, 0), GridLattice{}), std::invalid_argument);
 	const FrameResult& r = pipeline.process(empty, Eigen::Vector3d(0, 0, 0), GridLattice{});
 	EXPECT_TRUE(r.valid);
 	EXPECT_EQ(r.points, 0u);
@@ -209,8 +209,8 @@ TEST(Pipeline, CropsAtRobotHeightInTheRobotFrame)
 {
 	PipelineParams p;
 	p.ism.robot_height = 1.2;
-	const ProjectionFilter f = p.projectionFilter(0.5);	 // robot floor at z = 0.5 in the map
-	EXPECT_FLOAT_EQ(f.z_min, 0.5f - 3.0f);	// z_min = -3 (robot frame)
-	EXPECT_FLOAT_EQ(f.z_max, 0.5f + 1.2f);	// min(z_max 2.5, robot_height 1.2)
+	const ProjectionFilter f = p.projectionFilter(0.5);  // robot floor at z = 0.5 in the map
+	EXPECT_FLOAT_EQ(f.z_min, 0.5f - 3.0f);               // z_min = -3 (robot frame)
+	EXPECT_FLOAT_EQ(f.z_max, 0.5f + 1.2f);               // min(z_max 2.5, robot_height 1.2)
 	EXPECT_FLOAT_EQ(f.max_range, 5.0f);
 }

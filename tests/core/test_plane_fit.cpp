@@ -60,8 +60,7 @@ void report(const char* method, double tilt, const char* outliers, double angErr
 {
 	char buf[256];
 	std::snprintf(
-		buf, sizeof(buf),
-		"plane fit (%s): tilt %.0f deg, noise 1 cm, %s: angle error %.4f deg, offset error %.3f mm",
+		buf, sizeof(buf), "plane fit (%s): tilt %.0f deg, noise 1 cm, %s: angle error %.4f deg, offset error %.3f mm",
 		method, tilt, outliers, angErr, offErr);
 	std::cout << buf << std::endl;
 }
@@ -231,9 +230,9 @@ TEST(PlaneFitRansac, TiltLimitAndDegenerateInputs)
 	const auto pts = samplePlane(truth, 100, 0.0 + 1e-12, 0.0, data);
 	RansacParams rp;
 	std::mt19937 rng(1);
-	rp.max_horizontal_normal = 0.1;	 // 5.7 deg: the plane is too steep
+	rp.max_horizontal_normal = 0.1;  // 5.7 deg: the plane is too steep
 	EXPECT_FALSE(fitPlaneRansac(pts, rp, rng));
-	rp.max_horizontal_normal = 0.2;	 // 11.5 deg
+	rp.max_horizontal_normal = 0.2;  // 11.5 deg
 	const auto ok = fitPlaneRansac(pts, rp, rng);
 	ASSERT_TRUE(ok);
 	EXPECT_LT(angleErrorDeg(ok->plane, truth), 1e-6);

@@ -20,7 +20,7 @@ namespace
 {
 ElevationGrid floorWallBoxGrid()
 {
-	ElevationGrid grid;	 // -5..5 m, 5 cm
+	ElevationGrid grid;  // -5..5 m, 5 cm
 	std::mt19937 rng(11);
 	gamtest::buildFloorWallBox(grid, rng);
 	return grid;
@@ -64,8 +64,17 @@ TEST(RrtGpdParams, ValidateRejectsOutOfRangeValues)
 		{"s_y even", [](RrtGpdParams& p) { p.neighbourhood_y = 4; }},
 		{"s_x=0", [](RrtGpdParams& p) { p.neighbourhood_x = 0; }},
 		{"s_x=33", [](RrtGpdParams& p) { p.neighbourhood_x = 33; }},
-		{"s_x*s_y=1", [](RrtGpdParams& p) { p.neighbourhood_x = p.neighbourhood_y = 1; p.min_valid_cells = 3; }},
-		{"s_x=1 (collinear)", [](RrtGpdParams& p) { p.neighbourhood_x = 1; p.neighbourhood_y = 5; p.min_valid_cells = 3; }},
+		{"s_x*s_y=1",
+		 [](RrtGpdParams& p) {
+			 p.neighbourhood_x = p.neighbourhood_y = 1;
+			 p.min_valid_cells = 3;
+		 }},
+		{"s_x=1 (collinear)",
+		 [](RrtGpdParams& p) {
+			 p.neighbourhood_x = 1;
+			 p.neighbourhood_y = 5;
+			 p.min_valid_cells = 3;
+		 }},
 		{"d_n=0", [](RrtGpdParams& p) { p.expansion_distance = 0; }},
 		{"max_cell_std=0", [](RrtGpdParams& p) { p.max_cell_std = 0; }},
 		{"max_fit_rms<0", [](RrtGpdParams& p) { p.max_fit_rms = -1; }},
@@ -173,8 +182,8 @@ TEST(RrtGroundDetector, RecoversTiltedFloor)
 	const Plane& pl = out.plane();
 	const double tiltErr = std::abs(rad2deg(pl.tiltAngle()) - 3.0);
 	const double offErr = std::abs(pl.heightAt(0, 0));
-	std::cout << "RRT-GPD tilted floor 3 deg: tilt error " << tiltErr << " deg, height error at robot "
-			  << offErr * 1000 << " mm, " << out.nodes.size() << " nodes" << std::endl;
+	std::cout << "RRT-GPD tilted floor 3 deg: tilt error " << tiltErr << " deg, height error at robot " << offErr * 1000
+			  << " mm, " << out.nodes.size() << " nodes" << std::endl;
 	EXPECT_LT(tiltErr, 0.3);
 	EXPECT_LT(offErr, 0.01);
 	// Rising along +x: the upward normal leans to -x.
@@ -229,7 +238,8 @@ TEST(RrtGroundDetector, NoFloorNearExpectedHeight)
 	ElevationGrid grid;
 	std::mt19937 rng(5);
 	gam::BinnedPoints b;
-	gamtest::sampleSurface(grid, -2, 2, -2, 2, [](double, double) { return 1.0; }, 3, 0.003, rng, b);
+	gamtest::sampleSurface(
+		grid, -2, 2, -2, 2, [](double, double) { return 1.0; }, 3, 0.003, rng, b);
 	gamtest::insertAll(grid, b);
 	RrtGroundDetector det;
 	GroundDetection out;
@@ -255,7 +265,8 @@ TEST(RrtGroundDetector, NoFloorNearExpectedHeight)
 	// A floor beyond seed_search_radius (5 m) from the robot.
 	ElevationGrid farFloor;
 	b.clear();
-	gamtest::sampleSurface(farFloor, 3, 5, 3, 5, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
+	gamtest::sampleSurface(
+		farFloor, 3, 5, 3, 5, [](double, double) { return 0.0; }, 2, 0.0, rng, b);
 	gamtest::insertAll(farFloor, b);
 	det.detect(farFloor, GroundSeedHint{-3, -3, 0}, out);
 	EXPECT_EQ(out.status, Status::NoValidSeed);
@@ -275,7 +286,8 @@ TEST(RrtGroundDetector, EmptyGridAndTinyFloorPatch)
 	// fewer than min_nodes = 8.
 	std::mt19937 rng(2);
 	gam::BinnedPoints b;
-	gamtest::sampleSurface(grid, -0.08, 0.06, -0.08, 0.06, [](double, double) { return 0.0; }, 3, 0.002, rng, b);
+	gamtest::sampleSurface(
+		grid, -0.08, 0.06, -0.08, 0.06, [](double, double) { return 0.0; }, 3, 0.002, rng, b);
 	gamtest::insertAll(grid, b);
 	ASSERT_EQ(grid.observedCount(), 9u);
 	det.detect(grid, {}, out);
@@ -304,10 +316,11 @@ TEST(RrtGroundDetector, RetriesFromFloorWhenSeededOnABoxTop)
 	gamtest::sampleSurfaceIf(
 		grid, [&](double x, double y) { return gamtest::inRect(x, y, -3, 3, -3, 3) && !isBox(x, y); },
 		[](double, double) { return 0.0; }, 3, 0.003, rng, b);
-	gamtest::sampleSurfaceIf(grid, isBox, [](double, double) { return 0.2; }, 3, 0.003, rng, b);
+	gamtest::sampleSurfaceIf(
+		grid, isBox, [](double, double) { return 0.2; }, 3, 0.003, rng, b);
 	gamtest::insertAll(grid, b);
 
-	const GroundSeedHint hint{-0.025, -0.025, 0.1};	// box centre; 0 and 0.2 within +-0.3
+	const GroundSeedHint hint{-0.025, -0.025, 0.1};  // box centre; 0 and 0.2 within +-0.3
 	RrtGpdParams p;
 	p.seed_attempts = 1;
 	RrtGroundDetector one(p);
@@ -333,7 +346,7 @@ TEST(RrtGroundDetector, DeterministicForTheSameSeed)
 	GroundDetection a, b, c;
 	d1.detect(grid, {0, 0, 0}, a);
 	d2.detect(grid, {0, 0, 0}, b);
-	d1.detect(grid, {0, 0, 0}, c);	// reuse of the same detector (scratch state)
+	d1.detect(grid, {0, 0, 0}, c);  // reuse of the same detector (scratch state)
 	ASSERT_EQ(a.status, Status::Ok);
 	expectSameDetection(a, b);
 	expectSameDetection(a, c);
@@ -431,7 +444,8 @@ TEST(RrtGroundDetector, UpperStoreyFloorAtTenMetres)
 	ElevationGrid grid;
 	std::mt19937 rng(1);
 	gam::BinnedPoints b;
-	gamtest::sampleSurfaceIf(grid, FloorWallBox::isFloor, [](double, double) { return 10.0; }, 3, 0.003, rng, b);
+	gamtest::sampleSurfaceIf(
+		grid, FloorWallBox::isFloor, [](double, double) { return 10.0; }, 3, 0.003, rng, b);
 	gamtest::sampleColumns(grid, 2.5, 2.6, -3, 3, 10.0, 12.0, 0.05, b);
 	gamtest::insertAll(grid, b);
 	RrtGroundDetector det;
@@ -457,9 +471,7 @@ TEST(RrtGroundDetector, SparseFloorNeedsIdw)
 	const GridGeometry& g = grid.geometry();
 	gamtest::sampleSurfaceIf(
 		grid,
-		[&](double x, double y) {
-			return gamtest::inRect(x, y, -3, 3, -3, 3) && g.ix(x) % 2 == 0 && g.iy(y) % 2 == 0;
-		},
+		[&](double x, double y) { return gamtest::inRect(x, y, -3, 3, -3, 3) && g.ix(x) % 2 == 0 && g.iy(y) % 2 == 0; },
 		[](double, double) { return 0.0; }, 2, 0.003, rng, b);
 	gamtest::insertAll(grid, b);
 	const size_t observed = grid.observedCount();

@@ -59,8 +59,9 @@ void writeFile(const std::string& p, const std::string& s)
 std::string writeGt(const TempDir& d, const std::vector<std::string>& rows = kScene, double ox = 0, double oy = 0)
 {
 	const std::string prefix = d / "scene";
-	writeFile(prefix + "_gt.yaml", "image: scene_gt.pgm\nresolution: 0.1\norigin: [" + std::to_string(ox) + ", " +
-										std::to_string(oy) + ", 0.0]\nnegate: 0\n");
+	writeFile(
+		prefix + "_gt.yaml", "image: scene_gt.pgm\nresolution: 0.1\norigin: [" + std::to_string(ox) + ", " +
+								 std::to_string(oy) + ", 0.0]\nnegate: 0\n");
 	writeFile(
 		prefix + "_gt_objects.csv",
 		"id,name,type,category,min_x,min_y,min_z,max_x,max_y,max_z\n"
@@ -69,9 +70,9 @@ std::string writeGt(const TempDir& d, const std::vector<std::string>& rows = kSc
 	std::ostringstream l;
 	l << "ix,iy,x,y,label,object_id,category\n";
 	const int ny = int(rows.size()), nx = int(rows[0].size());
-	const std::map<char, std::pair<int, std::string>> obj = {
-		{'A', {1, "small"}}, {'B', {2, "negative"}}, {'C', {3, "large"}},
-		{'D', {4, "overhang"}}, {'r', {5, "ramp"}}, {'E', {6, "large"}}};
+	const std::map<char, std::pair<int, std::string>> obj = {{'A', {1, "small"}}, {'B', {2, "negative"}},
+															 {'C', {3, "large"}}, {'D', {4, "overhang"}},
+															 {'r', {5, "ramp"}},  {'E', {6, "large"}}};
 	for (int iy = 0; iy < ny; iy++)
 		for (int ix = 0; ix < nx; ix++)
 		{
@@ -79,13 +80,17 @@ std::string writeGt(const TempDir& d, const std::vector<std::string>& rows = kSc
 			std::string label = "free";
 			int id = 0;
 			std::string cat = "none";
-			if (c == '?' || c == 'E') label = "unobserved";
-			else if (c == 'B') label = "drop";
-			else if (c != '.' && c != 'r') label = "obstacle";
+			if (c == '?' || c == 'E')
+				label = "unobserved";
+			else if (c == 'B')
+				label = "drop";
+			else if (c != '.' && c != 'r')
+				label = "obstacle";
 			if (obj.count(c)) id = obj.at(c).first, cat = obj.at(c).second;
 			char b[128];
-			std::snprintf(b, sizeof(b), "%d,%d,%.4f,%.4f,%s,%d,%s\n", ix, iy, ox + (ix + 0.5) * kRes,
-						  oy + (iy + 0.5) * kRes, label.c_str(), id, cat.c_str());
+			std::snprintf(
+				b, sizeof(b), "%d,%d,%.4f,%.4f,%s,%d,%s\n", ix, iy, ox + (ix + 0.5) * kRes, oy + (iy + 0.5) * kRes,
+				label.c_str(), id, cat.c_str());
 			l << b;
 		}
 	writeFile(prefix + "_gt_labels.csv", l.str());
@@ -117,15 +122,17 @@ std::vector<std::vector<uint8_t>> perfectPixels(const std::vector<std::string>& 
 	{
 		std::vector<uint8_t> line;
 		for (char c : r)
-			for (int s = 0; s < sub; s++)
-				line.push_back(c == '?' || c == 'E' ? 128 : (c == '.' || c == 'r') ? 255 : 0);
+			for (int s = 0; s < sub; s++) line.push_back(c == '?' || c == 'E' ? 128 : (c == '.' || c == 'r') ? 255 : 0);
 		for (int s = 0; s < sub; s++) px.push_back(line);
 	}
 	return px;
 }
 
 /** Pixel of GT cell (ix, iy) in a perfectPixels(sub=1) image. */
-uint8_t& at(std::vector<std::vector<uint8_t>>& px, int ix, int iy) { return px[px.size() - 1 - size_t(iy)][size_t(ix)]; }
+uint8_t& at(std::vector<std::vector<uint8_t>>& px, int ix, int iy)
+{
+	return px[px.size() - 1 - size_t(iy)][size_t(ix)];
+}
 
 const CategoryScore& cat(const Reading& r, const std::string& c) { return r.categories.at(c); }
 
@@ -319,15 +326,17 @@ TEST(Eval, OutputsNameEveryMapAndCategory)
 {
 	TempDir d;
 	const GroundTruth gt = loadGroundTruth(writeGt(d));
-	std::vector<MapScore> v{evaluate(gt, loadRosMap(writeMap(d, "ground_aware", perfectPixels(), kRes, 0, 0))),
-							evaluate(gt, loadRosMap(writeMap(d, "octomap", perfectPixels(), kRes, 0, 0)))};
+	std::vector<MapScore> v{
+		evaluate(gt, loadRosMap(writeMap(d, "ground_aware", perfectPixels(), kRes, 0, 0))),
+		evaluate(gt, loadRosMap(writeMap(d, "octomap", perfectPixels(), kRes, 0, 0)))};
 	const std::string table = formatTable(gt, v, {});
 	EXPECT_NE(table.find("ground_aware"), std::string::npos);
 	EXPECT_NE(table.find("octomap"), std::string::npos);
 	EXPECT_NE(table.find("1/1 (100%)"), std::string::npos);
 	const std::string js = toJson(gt, v, {});
-	for (const char* k : {"\"negative\"", "\"small\"", "\"overhang\"", "\"large\"", "\"floor_false_obstacle_pct\": 0.000",
-						  "\"floor_free_pct\": 100.000", "\"map_server\"", "\"detected\": true"})
+	for (const char* k :
+		 {"\"negative\"", "\"small\"", "\"overhang\"", "\"large\"", "\"floor_false_obstacle_pct\": 0.000",
+		  "\"floor_free_pct\": 100.000", "\"map_server\"", "\"detected\": true"})
 		EXPECT_NE(js.find(k), std::string::npos) << k;
 	const std::string csv = toCsv(v);
 	EXPECT_EQ(csv.rfind("map,reading,record,id,category,n,occupied,free,unknown,detected\n", 0), 0u);
@@ -415,10 +424,11 @@ TEST(EvalCli, WritesJsonCsvPngAndFailsCleanly)
 	const std::string m1 = writeMap(d, "ground_aware", perfectPixels(), kRes, 0, 0);
 	const std::string m2 = writeMap(d, "octomap", perfectPixels(), kRes, 0, 0);
 	const std::string err = d / "err.txt";
-	EXPECT_EQ(run("--gt " + prefix + " --map " + m1 + " --map " + m2 + " --json " + (d / "o.json") + " --csv " +
-					  (d / "o.csv") + " --png " + (d / "o.png"),
-				  err),
-			  0);
+	EXPECT_EQ(
+		run("--gt " + prefix + " --map " + m1 + " --map " + m2 + " --json " + (d / "o.json") + " --csv " +
+				(d / "o.csv") + " --png " + (d / "o.png"),
+			err),
+		0);
 	EXPECT_NE(slurp(d / "o.json").find("\"name\": \"octomap\""), std::string::npos);
 	EXPECT_NE(slurp(d / "o.csv").find("ground_aware,main,floor"), std::string::npos);
 	// the same map file name from two folders: told apart by the folder

@@ -36,8 +36,8 @@ inline mrpt::obs::CObservation3DRangeScan::Ptr tinyFrame()
 			// Ray (1, ky, kz) in the sensor frame; its z in the world after the pitch.
 			const double kz = (11.5 - r) / 24.0;
 			const double dz = -std::sin(p) + kz * std::cos(p), dx = std::cos(p) + kz * std::sin(p);
-			double D = dz < -1e-3 ? 1.0 / -dz : 0;	// depth along the optical axis
-			if (D * dx > 2.0) D = D * 0.97;	 // a 3 cm step beyond 2 m
+			double D = dz < -1e-3 ? 1.0 / -dz : 0;  // depth along the optical axis
+			if (D * dx > 2.0) D = D * 0.97;         // a 3 cm step beyond 2 m
 			o->rangeImage(r, c) = (D > 0 && D < 5) ? uint16_t(std::lround(D * 1000)) : 0;
 		}
 	return o;

@@ -20,12 +20,12 @@
 #include <unistd.h>
 
 #include <array>
-#include <set>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -37,7 +37,8 @@ namespace
 const std::string kExe = GAM_MAPPER_EXE;
 // One work folder per process: ctest may run these tests in parallel.
 const std::string kTmp = std::string(GAM_TEST_TMP_DIR) + "/p" + std::to_string(getpid());
-const std::string kMilk = std::string(GAM_REAL_DATA_DIR) + "/pcl_milk_bottles_on_carpet/pcl_milk_bottles_on_carpet.rawlog";
+const std::string kMilk =
+	std::string(GAM_REAL_DATA_DIR) + "/pcl_milk_bottles_on_carpet/pcl_milk_bottles_on_carpet.rawlog";
 const std::vector<std::string> kGrids = {"ground_aware", "height_band", "octomap"};
 
 struct RunResult
@@ -84,9 +85,9 @@ struct Box
 // Floor (top z = 0, thick) with a 0.5 x 0.5 m hole 0.5 m deep, and a box.
 const Box kBoxObstacle{1.4, 1.7, 0.3, 0.7, 0.0, 0.5};
 const Box kHole{2.0, 2.5, -0.6, -0.1, -0.5, 0.0};  // the empty part
-const std::vector<Box> kScene = {
-	{-10, 2.0, -10, 10, -1, 0}, {2.5, 10, -10, 10, -1, 0}, {2.0, 2.5, -10, -0.6, -1, 0},
-	{2.0, 2.5, -0.1, 10, -1, 0}, {2.0, 2.5, -0.6, -0.1, -1, -0.5}, kBoxObstacle};
+const std::vector<Box> kScene = {{-10, 2.0, -10, 10, -1, 0},       {2.5, 10, -10, 10, -1, 0},
+								 {2.0, 2.5, -10, -0.6, -1, 0},     {2.0, 2.5, -0.1, 10, -1, 0},
+								 {2.0, 2.5, -0.6, -0.1, -1, -0.5}, kBoxObstacle};
 
 double rayBox(const mrpt::math::TPoint3D& o, const mrpt::math::TPoint3D& d, const Box& b)
 {
@@ -134,7 +135,8 @@ mrpt::obs::CObservation3DRangeScan::Ptr makeFrame(double robotX)
 		{
 			const double ds[3] = {1.0, (cx - c) / fx, (cy - r) / fy};
 			mrpt::math::TPoint3D d(
-				R(0, 0) * ds[0] + R(0, 1) * ds[1] + R(0, 2) * ds[2], R(1, 0) * ds[0] + R(1, 1) * ds[1] + R(1, 2) * ds[2],
+				R(0, 0) * ds[0] + R(0, 1) * ds[1] + R(0, 2) * ds[2],
+				R(1, 0) * ds[0] + R(1, 1) * ds[1] + R(1, 2) * ds[2],
 				R(2, 0) * ds[0] + R(2, 1) * ds[1] + R(2, 2) * ds[2]);
 			double best = std::numeric_limits<double>::infinity();
 			for (const auto& b : kScene)
@@ -411,7 +413,9 @@ TEST(MapperReal, MilkBottlesSensoryFrameFormatGivesTheSameMaps)
 	for (const auto& n : kGrids)
 	{
 		SCOPED_TRACE(n);
-		EXPECT_TRUE(readGridmapGz(a + "/" + n + ".gridmap.gz").getRawMap() == readGridmapGz(b + "/" + n + ".gridmap.gz").getRawMap());
+		EXPECT_TRUE(
+			readGridmapGz(a + "/" + n + ".gridmap.gz").getRawMap() ==
+			readGridmapGz(b + "/" + n + ".gridmap.gz").getRawMap());
 		EXPECT_EQ(slurp(a + "/" + n + ".pgm"), slurp(b + "/" + n + ".pgm"));
 	}
 	EXPECT_EQ(slurp(a + "/ground_planes.csv"), slurp(b + "/ground_planes.csv"));
@@ -579,7 +583,8 @@ TEST_F(MapperE2E, BadInputsGiveOneLineErrors)
 	expectError(
 		runMapper(
 			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +
-			withDefaultConfigEdited("stocktypo", "\nmaxOccupancyUpdateCertainty=0.65", "\nmaxOccupancyUpdateCertainy=0.65") +
+			withDefaultConfigEdited(
+				"stocktypo", "\nmaxOccupancyUpdateCertainty=0.65", "\nmaxOccupancyUpdateCertainy=0.65") +
 			"'"),
 		2, {"maxOccupancyUpdateCertainy", "is not used by"}, out);
 	// Unknown map type.
@@ -592,7 +597,8 @@ TEST_F(MapperE2E, BadInputsGiveOneLineErrors)
 	expectError(
 		runMapper(
 			"--rawlog '" + obsRawlog + "' --out '" + out + "' --config '" +
-			withDefaultConfigEdited("section", "[map_octoMapGrid_00_octoOpts]", "[map_octoMapGrid_00_octoOptions]") + "'"),
+			withDefaultConfigEdited("section", "[map_octoMapGrid_00_octoOpts]", "[map_octoMapGrid_00_octoOptions]") +
+			"'"),
 		2, {"unknown section [map_octoMapGrid_00_octoOptions]"}, out);
 	// Unwritable output directory (its parent is a file).
 	{
@@ -655,7 +661,10 @@ TEST(MapperCli, MapsComeFromTheIniAlone)
 	const std::string out = freshDir("out_custom");
 	const auto r = runMapper("--rawlog '" + rawlog + "' --out '" + out + "' --config '" + ini + "' -q");
 	ASSERT_EQ(r.rc, 0) << r.err;
-	EXPECT_NE(r.err.find("ground-aware-mapper: warning: [map_occupancyGrid_00_insertOpts] key 'maxDistanceInsertoin'"), std::string::npos) << r.err;
+	EXPECT_NE(
+		r.err.find("ground-aware-mapper: warning: [map_occupancyGrid_00_insertOpts] key 'maxDistanceInsertoin'"),
+		std::string::npos)
+		<< r.err;
 	EXPECT_NE(r.out.find("frames: 3 (0 3D scans, 3 2D scans)"), std::string::npos) << r.out;
 	for (const std::string n : {"stock", "groundAwareGrid_00"})
 		for (const char* ext : {".yaml", ".pgm", ".gridmap.gz", ".png"})

@@ -49,8 +49,8 @@ inline double castRay(const std::vector<Box>& boxes, const mrpt::math::TPoint3D&
 /** A solid floor (top at z = 0) over [x0,x1]x[y0,y1] with an optional
  * rectangular pit of the given depth: the pit has walls and a bottom. */
 inline std::vector<Box> floorWithHole(
-	double x0, double x1, double y0, double y1, double hx0 = 0, double hx1 = 0, double hy0 = 0,
-	double hy1 = 0, double holeDepth = 0.5)
+	double x0, double x1, double y0, double y1, double hx0 = 0, double hx1 = 0, double hy0 = 0, double hy1 = 0,
+	double holeDepth = 0.5)
 {
 	const double zb = -holeDepth - 0.1;
 	if (hx1 <= hx0) return {{x0, y0, zb, x1, y1, 0.0}};
@@ -65,8 +65,8 @@ inline std::vector<Box> floorWithHole(
 /** A Kinect-One-like depth frame (W x H, ~70x60 deg) of `boxes`, taken by a
  * sensor at `sensorPose` on a robot at `robotPose`. Depth along +X, mm. */
 inline mrpt::obs::CObservation3DRangeScan::Ptr renderDepth(
-	const std::vector<Box>& boxes, const mrpt::poses::CPose3D& sensorPose,
-	const mrpt::poses::CPose3D& robotPose = {}, int W = 256, int H = 212, double maxRange = 4.5)
+	const std::vector<Box>& boxes, const mrpt::poses::CPose3D& sensorPose, const mrpt::poses::CPose3D& robotPose = {},
+	int W = 256, int H = 212, double maxRange = 4.5)
 {
 	auto o = mrpt::obs::CObservation3DRangeScan::Create();
 	o->sensorLabel = "KINECT";

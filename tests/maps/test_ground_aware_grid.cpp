@@ -100,9 +100,10 @@ TEST(GroundAwareGrid, OverheadBeamDoesNotBlockButATableDoes)
 {
 	// A camera 0.9 m up sees a beam at 1.1-1.2 m (above robot_height = 1.0)
 	// and a table top at 0.7 m (below it), both from x = 2.5.
-	std::vector<Box> s = {{-1, -3, -0.1, 8, 3, 0.0},
-						  {2.5, -1.5, 1.1, 3.5, -0.5, 1.2},	 // beam
-						  {2.5, 0.5, 0.68, 3.5, 1.5, 0.72}};	 // table top
+	std::vector<Box> s = {
+		{-1, -3, -0.1, 8, 3, 0.0},
+		{2.5, -1.5, 1.1, 3.5, -0.5, 1.2},   // beam
+		{2.5, 0.5, 0.68, 3.5, 1.5, 0.72}};  // table top
 	CGroundAwareOccupancyGrid g;
 	auto o = g.groundOptions();
 	o.pipeline.ism.robot_height = 1.0;

@@ -18,8 +18,8 @@ namespace
 using testdata::firstScan;
 using testdata::realData;
 
-#define LOAD_OR_SKIP(var, rel)                                                        \
-	auto var = firstScan(rel);                                                        \
+#define LOAD_OR_SKIP(var, rel) \
+	auto var = firstScan(rel); \
 	if (!var) GTEST_SKIP() << "real data not found: " << realData(rel);
 
 double pOcc(const COccupancyGridMap2D& g, double x, double y) { return 1.0 - g.getPos(float(x), float(y)); }
@@ -61,8 +61,8 @@ TEST(RealData, MrptFloorScanGroundMatchesTheStoredPose)
 	// residual tilt (dataset README): the detector must find that floor.
 	const double tiltDeg = d.plane().tiltAngle() * 180 / M_PI;
 	const double z = d.plane().heightAt(0.5, 0.0);
-	std::cout << "[real] mrpt_3d_obs_ground: tilt " << tiltDeg << " deg, floor z at (0.5, 0) = " << z
-			  << " m, nodes " << d.nodes.size() << "\n";
+	std::cout << "[real] mrpt_3d_obs_ground: tilt " << tiltDeg << " deg, floor z at (0.5, 0) = " << z << " m, nodes "
+			  << d.nodes.size() << "\n";
 	EXPECT_NEAR(tiltDeg, 1.8, 1.0);
 	EXPECT_NEAR(z, 0.001, 0.02);
 	const Census c = census(g);
@@ -87,8 +87,8 @@ TEST(RealData, ElevationMapMatchesMrptUnprojection)
 		m->setInsertionOptions(opts);
 	}
 	auto oc = *o;
-	oc.hasPoints3D = false;	 // force the range-image path
-	oc.maxRange = 100;  // unprojectInto() ignores maxRange
+	oc.hasPoints3D = false;  // force the range-image path
+	oc.maxRange = 100;       // unprojectInto() ignores maxRange
 	direct.insertObservation(oc);
 	CSimplePointsMap pts;
 	T3DPointsProjectionParams pp;
@@ -106,7 +106,8 @@ TEST(RealData, ElevationMapMatchesMrptUnprojection)
 		total += b.cell(i).count;
 		countDiff += size_t(std::abs(int64_t(a.cell(i).count) - int64_t(b.cell(i).count)));
 		cells++;
-		zAgree += std::abs(a.cell(i).z_max - b.cell(i).z_max) < 0.005 && std::abs(a.cell(i).z_min - b.cell(i).z_min) < 0.005;
+		zAgree +=
+			std::abs(a.cell(i).z_max - b.cell(i).z_max) < 0.005 && std::abs(a.cell(i).z_min - b.cell(i).z_min) < 0.005;
 	}
 	std::cout << "[real] projection vs MRPT unprojectInto: " << total << " points, count difference " << countDiff
 			  << ", heights agree in " << zAgree << " of " << cells << " cells\n";

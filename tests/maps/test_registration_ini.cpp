@@ -1,8 +1,8 @@
 // Plugin registration, CMultiMetricMap .ini construction and option checks.
+#include <gam/maps/IniFields.h>
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
-#include <gam/maps/IniFields.h>
 #include <mrpt/maps/CElevation25DMap.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/maps/CMultiMetricMap.h>
@@ -27,8 +27,9 @@ TEST(Registration, ClassesKnownToMrptRtti)
 	registerGroundAwareMaps();
 	EXPECT_NE(mrpt::rtti::findRegisteredClass("mrpt::maps::CElevation25DMap"), nullptr);
 	EXPECT_NE(mrpt::rtti::findRegisteredClass("mrpt::maps::CGroundAwareOccupancyGrid"), nullptr);
-	for (const char* name : {"CElevation25DMap", "elevation25DMap", "CGroundAwareOccupancyGrid", "groundAwareGrid",
-							 "mrpt::maps::CGroundAwareOccupancyGrid"})
+	for (const char* name :
+		 {"CElevation25DMap", "elevation25DMap", "CGroundAwareOccupancyGrid", "groundAwareGrid",
+		  "mrpt::maps::CGroundAwareOccupancyGrid"})
 	{
 		std::unique_ptr<TMetricMapInitializer> def(TMetricMapInitializer::factory(name));
 		EXPECT_TRUE(def) << name;
@@ -90,8 +91,9 @@ TEST(IniConstruction, LeddarNoReturnIsNotFreeSpaceFromIniEither)
 {
 	CMultiMetricMap mm(initsFrom("[map]\ngroundAwareGrid_count=1\n"));
 	EXPECT_FALSE(mm.mapByClass<CGroundAwareOccupancyGrid>()->insertionOptions.considerInvalidRangesAsFreeSpace);
-	CMultiMetricMap explicitOn(initsFrom(
-		"[map]\ngroundAwareGrid_count=1\n[map_groundAwareGrid_00_insertOpts]\nconsiderInvalidRangesAsFreeSpace=true\n"));
+	CMultiMetricMap explicitOn(
+		initsFrom("[map]\ngroundAwareGrid_count=1\n[map_groundAwareGrid_00_insertOpts]"
+				  "\nconsiderInvalidRangesAsFreeSpace=true\n"));
 	EXPECT_TRUE(explicitOn.mapByClass<CGroundAwareOccupancyGrid>()->insertionOptions.considerInvalidRangesAsFreeSpace);
 }
 
@@ -99,14 +101,14 @@ TEST(IniConstruction, DefaultsAreThePaperTableI)
 {
 	CGroundAwareOccupancyGrid g;
 	const gam::PipelineParams& o = g.groundOptions().pipeline;
-	EXPECT_EQ(o.rrt.iterations, 600);  // K
-	EXPECT_DOUBLE_EQ(o.rrt.normal_threshold, 0.2);	// N_th
-	EXPECT_DOUBLE_EQ(o.rrt.elevation_threshold, 0.05);	// E_th
-	EXPECT_EQ(o.rrt.neighbourhood_x, 3);  // s_x
-	EXPECT_EQ(o.rrt.neighbourhood_y, 3);  // s_y
+	EXPECT_EQ(o.rrt.iterations, 600);                   // K
+	EXPECT_DOUBLE_EQ(o.rrt.normal_threshold, 0.2);      // N_th
+	EXPECT_DOUBLE_EQ(o.rrt.elevation_threshold, 0.05);  // E_th
+	EXPECT_EQ(o.rrt.neighbourhood_x, 3);                // s_x
+	EXPECT_EQ(o.rrt.neighbourhood_y, 3);                // s_y
 	EXPECT_EQ(o.m_x, 200);
 	EXPECT_EQ(o.m_y, 200);
-	EXPECT_NEAR(g.getResolution(), 0.05, 1e-7);	 // d_r
+	EXPECT_NEAR(g.getResolution(), 0.05, 1e-7);       // d_r
 	EXPECT_DOUBLE_EQ(o.rrt.expansion_distance, 0.4);  // d_n
 	EXPECT_DOUBLE_EQ(o.ism.d_pth, 0.03);
 	EXPECT_DOUBLE_EQ(o.ism.K_g, 0.3);
@@ -125,17 +127,25 @@ TEST(IniConstruction, ExampleConfigLoadsWithTableIValues)
 	auto ga = mm.mapByClass<CGroundAwareOccupancyGrid>();
 	ASSERT_TRUE(ga);
 	CGroundAwareOccupancyGrid ref;
-	// Every key of the example is spelled right and holds the default.
+	// Every key of the example is spelled right and holds the default, and the
+	// paper's Table I keys are all there. (Other keys may be left out: their
+	// reference is the core's parameter table, so adding a parameter is one
+	// edit of its struct.)
 	using Options = CGroundAwareOccupancyGrid::TGroundAwareOptions;
 	const std::string sec = "map_groundAwareGrid_00_groundOpts";
 	std::vector<double> loaded, defaults;
+	std::vector<std::string> names;
 	Options::forEachParam(ga->groundOptions(), [&](const gam::ParamInfo& info, const auto& v) {
-		EXPECT_TRUE(cfg.keyExists(sec, info.key)) << info.key << " missing in the example";
+		names.push_back(info.key);
 		loaded.push_back(double(v));
 	});
-	Options::forEachParam(ref.groundOptions(), [&](const gam::ParamInfo&, const auto& v) { defaults.push_back(double(v)); });
+	Options::forEachParam(
+		ref.groundOptions(), [&](const gam::ParamInfo&, const auto& v) { defaults.push_back(double(v)); });
 	ASSERT_EQ(loaded.size(), defaults.size());
-	for (size_t i = 0; i < loaded.size(); i++) EXPECT_DOUBLE_EQ(loaded[i], defaults[i]) << "key #" << i;
+	for (size_t i = 0; i < loaded.size(); i++) EXPECT_DOUBLE_EQ(loaded[i], defaults[i]) << names[i];
+	for (const char* k :
+		 {"K", "N_th", "E_th", "s_x", "s_y", "m_x", "m_y", "d_n", "d_pth", "K_g", "sigma2", "K_n", "d_min", "K_m"})
+		EXPECT_TRUE(cfg.keyExists(sec, k)) << k << " missing in the example";
 	// ... and it has no key the options do not know.
 	std::vector<std::string> keys;
 	cfg.getAllKeys(sec, keys);
@@ -150,9 +160,15 @@ TEST(IniConstruction, OutOfRangeValuesNameTheKey)
 		std::string section, key, value;
 	};
 	const std::vector<Case> bad = {
-		{"groundOpts", "K", "0"},		  {"groundOpts", "s_x", "4"},	  {"groundOpts", "s_y", "1"},	   {"groundOpts", "N_th", "1.5"},
-		{"groundOpts", "d_pth", "-0.1"},  {"groundOpts", "K_m", "1.2"},	   {"groundOpts", "m_x", "0"},
-		{"groundOpts", "E_th", "abc"},	  {"groundOpts", "drop_rays", "maybe"},
+		{"groundOpts", "K", "0"},
+		{"groundOpts", "s_x", "4"},
+		{"groundOpts", "s_y", "1"},
+		{"groundOpts", "N_th", "1.5"},
+		{"groundOpts", "d_pth", "-0.1"},
+		{"groundOpts", "K_m", "1.2"},
+		{"groundOpts", "m_x", "0"},
+		{"groundOpts", "E_th", "abc"},
+		{"groundOpts", "drop_rays", "maybe"},
 		{"creationOpts", "resolution", "-0.05"}};
 	for (const auto& c : bad)
 	{
@@ -171,10 +187,12 @@ TEST(IniConstruction, OutOfRangeValuesNameTheKey)
 		}
 	}
 	// Elevation map too.
-	EXPECT_THROW(initsFrom("[map]\nCElevation25DMap_count=1\n[map_CElevation25DMap_00_insertOpts]\ndecimation=0\n"),
-				 std::exception);
-	EXPECT_THROW(initsFrom("[map]\nCElevation25DMap_count=1\n[map_CElevation25DMap_00_insertOpts]\nz_min=2\nz_max=1\n"),
-				 std::exception);
+	EXPECT_THROW(
+		initsFrom("[map]\nCElevation25DMap_count=1\n[map_CElevation25DMap_00_insertOpts]\ndecimation=0\n"),
+		std::exception);
+	EXPECT_THROW(
+		initsFrom("[map]\nCElevation25DMap_count=1\n[map_CElevation25DMap_00_insertOpts]\nz_min=2\nz_max=1\n"),
+		std::exception);
 }
 
 TEST(IniConstruction, SaveThenLoadGivesTheSameOptions)

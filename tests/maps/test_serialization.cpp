@@ -81,14 +81,15 @@ TEST(Serialization, MultiMetricMapCopyClonesBothMaps)
 	inits.push_back(d2);
 	CMultiMetricMap a(inits);
 	a.insertObservation(*testscene::renderDepth(boxScene(), kKinect));
-	CMultiMetricMap b = a;	// MRPT copies by serializing every child
+	CMultiMetricMap b = a;  // MRPT copies by serializing every child
 	ASSERT_EQ(b.maps.size(), 2u);
 	auto ga = a.mapByClass<CGroundAwareOccupancyGrid>(), gb = b.mapByClass<CGroundAwareOccupancyGrid>();
 	ASSERT_TRUE(gb);
 	EXPECT_EQ(gb->groundOptions().pipeline.rrt.iterations, 250);
 	EXPECT_EQ(ga->getRawMap(), gb->getRawMap());
-	EXPECT_EQ(a.mapByClass<CElevation25DMap>()->grid().observedCount(),
-			  b.mapByClass<CElevation25DMap>()->grid().observedCount());
+	EXPECT_EQ(
+		a.mapByClass<CElevation25DMap>()->grid().observedCount(),
+		b.mapByClass<CElevation25DMap>()->grid().observedCount());
 	// compute3DMatchingRatio must not throw for our maps (CMultiMetricMap calls it on all).
 	EXPECT_NO_THROW(a.compute3DMatchingRatio(&b, CPose3D(), TMatchingRatioParams()));
 }

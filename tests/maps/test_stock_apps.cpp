@@ -51,8 +51,8 @@ TEST(StockApps, Observations2mapBuildsOurMapsThroughLdPreload)
 	ASSERT_TRUE(sm.saveToFile(dir + "/in.simplemap"));
 	// The example .ini as it is, with observations2map's section name.
 	const std::string ini = std::regex_replace(
-		slurp(std::string(GAM_SOURCE_DIR) + "/config/ground-aware-grid.ini"), std::regex("^\\[map", std::regex::multiline),
-		"[MappingApplication");
+		slurp(std::string(GAM_SOURCE_DIR) + "/config/ground-aware-grid.ini"),
+		std::regex("^\\[map", std::regex::multiline), "[MappingApplication");
 	std::ofstream(dir + "/o2m.ini") << ini;
 
 	const std::string cmd = "cd " + dir + " && LD_PRELOAD=" + GAM_PLUGIN_PATH +

@@ -64,12 +64,12 @@ TEST_F(NavExample, GroundAwarePathGoesAroundTheHole)
 	const auto plan = gam::nav::planPath(maps->groundAware, kStart, kGoal, po);
 	ASSERT_TRUE(plan.found);
 	const auto holes = holeCells(maps->groundAware);
-	ASSERT_GT(holes.size(), 100u);	// 0.6 x 0.6 m at 5 cm
+	ASSERT_GT(holes.size(), 100u);  // 0.6 x 0.6 m at 5 cm
 	double closest = 1e9;
 	for (const auto& p : plan.path)
 		for (const auto& h : holes) closest = std::min(closest, (p - h).norm());
 	EXPECT_GE(closest, po.robotRadius) << "a path cell is within robotRadius of the hole";
-	EXPECT_GT(plan.maxDeviation, 0.3 + po.robotRadius - 0.05);	// it had to swerve
+	EXPECT_GT(plan.maxDeviation, 0.3 + po.robotRadius - 0.05);  // it had to swerve
 	EXPECT_NEAR(plan.path.back().x, kGoal.x, 1e-6);
 	EXPECT_LT(plan.length, 7.0);
 }

@@ -63,8 +63,8 @@ TEST_F(ReactiveNav, GroundAwareObstaclesSteerAroundTheHatch)
 	if (!haveConfig()) GTEST_SKIP() << "mrpt-common's reactive2d_config.ini is not installed";
 	const auto r = drive(maps->groundAware);
 	ASSERT_GE(r.trajectory.size(), 2u);
-	EXPECT_TRUE(r.reached) << r.endState << " after " << r.seconds << " s at (" << r.trajectory.back().x
-						   << ", " << r.trajectory.back().y << ")";
+	EXPECT_TRUE(r.reached) << r.endState << " after " << r.seconds << " s at (" << r.trajectory.back().x << ", "
+						   << r.trajectory.back().y << ")";
 	EXPECT_GT(closestToHole(r), 0.2) << "the robot centre came close to the hatch";
 }
 

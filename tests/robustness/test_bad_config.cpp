@@ -63,7 +63,7 @@ TEST(RobustConfig, EveryMapKindRejectsBadExtentsAndResolution)
 		{"resolution=0\n", "resolution"},
 		{"resolution=nan\n", "resolution"},
 		{"resolution=inf\n", "resolution"},
-		{"min_x=2\nmax_x=2\n", "min_x < max_x"},	// zero cells
+		{"min_x=2\nmax_x=2\n", "min_x < max_x"},   // zero cells
 		{"min_y=3\nmax_y=-3\n", "min_x < max_x"},  // negative size
 		{"min_x=abc\n", "min_x"}};
 	for (const auto& kind : kKinds)
@@ -100,16 +100,20 @@ TEST(RobustConfig, MapsTooLargeForMemoryAreRefusedBeforeAllocating)
 	// Just over the limits: 2D grids 2^28 cells, the elevation map 2^26.
 	for (const auto& kind : {"groundAwareGrid", "heightBandGrid", "octoMapGrid"})
 	{
-		EXPECT_EQ(buildError(oneMap(kind, "creationOpts", "min_x=0\nmax_x=1600\nmin_y=0\nmax_y=1600\nresolution=0.1\n")), "")
+		EXPECT_EQ(
+			buildError(oneMap(kind, "creationOpts", "min_x=0\nmax_x=1600\nmin_y=0\nmax_y=1600\nresolution=0.1\n")), "")
 			<< kind << ": 16000 x 16000 cells are fine";
-		EXPECT_NE(buildError(oneMap(kind, "creationOpts", "min_x=0\nmax_x=1700\nmin_y=0\nmax_y=1700\nresolution=0.1\n"))
-					  .find("too large"),
-				  std::string::npos)
+		EXPECT_NE(
+			buildError(oneMap(kind, "creationOpts", "min_x=0\nmax_x=1700\nmin_y=0\nmax_y=1700\nresolution=0.1\n"))
+				.find("too large"),
+			std::string::npos)
 			<< kind << ": 17000 x 17000 cells";
 	}
-	EXPECT_NE(buildError(oneMap("CElevation25DMap", "creationOpts", "min_x=0\nmax_x=900\nmin_y=0\nmax_y=900\nresolution=0.1\n"))
-				  .find("too large"),
-			  std::string::npos);
+	EXPECT_NE(
+		buildError(
+			oneMap("CElevation25DMap", "creationOpts", "min_x=0\nmax_x=900\nmin_y=0\nmax_y=900\nresolution=0.1\n"))
+			.find("too large"),
+		std::string::npos);
 }
 
 TEST(RobustConfig, ThresholdsOutOfRangeForTheComparisonAndElevationMaps)

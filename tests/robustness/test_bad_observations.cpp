@@ -218,7 +218,8 @@ TEST(RobustObservations, UpsideDownSensorGivesTheSameGroundAwareMap)
 		for (float y = -1.0f; y < 1.0f; y += 0.05f)
 		{
 			n++;
-			same += (a.getPos(x, y) > 0.5f) == (b.getPos(x, y) > 0.5f) || std::abs(a.getPos(x, y) - b.getPos(x, y)) < 0.1f;
+			same +=
+				(a.getPos(x, y) > 0.5f) == (b.getPos(x, y) > 0.5f) || std::abs(a.getPos(x, y) - b.getPos(x, y)) < 0.1f;
 		}
 	EXPECT_GE(same, n * 95 / 100);
 }
@@ -227,8 +228,7 @@ TEST(RobustObservations, SensorPointingAtTheSkyFindsNoFloorAndAddsNothing)
 {
 	// Upside-down pitch: the camera looks straight up; nothing in view.
 	auto o = goodFrame(CPose3D(0, 0, 1.0, 0, mrpt::DEG2RAD(-90.0), 0));
-	for (auto& m : allMaps())
-		EXPECT_NO_THROW(m.map->insertObservation(o)) << m.name;
+	for (auto& m : allMaps()) EXPECT_NO_THROW(m.map->insertObservation(o)) << m.name;
 	CGroundAwareOccupancyGrid g;
 	const auto before = robust::gridCells(g);
 	g.insertObservation(o);
@@ -352,7 +352,8 @@ TEST(RobustObservations, EmptyAndDegenerate2DScans)
 	s.aperture = float(M_PI);
 	s.maxRange = 10;
 	s.resizeScan(16);
-	const float vals[4] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), -3.f, 1e30f};
+	const float vals[4] = {
+		std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), -3.f, 1e30f};
 	for (size_t i = 0; i < 16; i++)
 	{
 		s.setScanRange(i, vals[i % 4]);

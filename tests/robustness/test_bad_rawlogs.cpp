@@ -236,7 +236,7 @@ TEST(RobustRawlogs, ObjectsOfUnexpectedClassesAreSkipped)
 	{
 		mrpt::io::CFileGZOutputStream out(f);
 		auto ar = mrpt::serialization::archiveFrom(out);
-		ar << mrpt::poses::CPose2D(1, 2, 0.3);	// not an observation at all
+		ar << mrpt::poses::CPose2D(1, 2, 0.3);  // not an observation at all
 		mrpt::maps::CSimpleMap sm;
 		ar << sm;
 		mrpt::obs::CObservationImage img;
@@ -287,8 +287,8 @@ TEST(RobustRawlogs, AbsurdElementCountIsAnErrorNotGigabytes)
 {
 	// Found by tests/fuzz/fuzz_rawlog: MRPT resizes a CActionCollection / CSensoryFrame
 	// to the stored count before reading any element; 0x6d9c6da1 elements = 29 GB.
-	for (const auto& [name, version] :
-		 std::vector<std::pair<std::string, char>>{{"mrpt::obs::CActionCollection", 0}, {"mrpt::obs::CSensoryFrame", 2}})
+	for (const auto& [name, version] : std::vector<std::pair<std::string, char>>{
+			 {"mrpt::obs::CActionCollection", 0}, {"mrpt::obs::CSensoryFrame", 2}})
 	{
 		std::string b;
 		b += char(0x80 | name.size());

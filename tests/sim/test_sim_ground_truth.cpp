@@ -35,8 +35,8 @@ struct Fixture
 		KinectParams kp;
 		kp.noise = false;
 		std::mt19937 rng(1);
-		const DepthFrame f = KinectModel(kp).render(
-			sf.scene, Pose3::fromXYZYPR(0, 0, 0, 0, 0, 0) * sf.kinect_pose, rng);
+		const DepthFrame f =
+			KinectModel(kp).render(sf.scene, Pose3::fromXYZYPR(0, 0, 0, 0, 0, 0) * sf.kinect_pose, rng);
 		gt.markObserved(f.footprint);
 	}
 };
@@ -79,7 +79,7 @@ TEST(SimGroundTruth, LabelsIdsAndCategories)
 	EXPECT_EQ(gt.objectAt(2.0, -1.2), 7);
 	EXPECT_EQ(fx.sf.scene.object(7)->category, Category::Ramp);
 	EXPECT_EQ(geom(1.9, 1.6), Label::Obstacle);
-	EXPECT_EQ(gt.labelAt(1.9, 1.6), Label::Unobserved);	 // 42 deg azimuth: outside the FOV
+	EXPECT_EQ(gt.labelAt(1.9, 1.6), Label::Unobserved);  // 42 deg azimuth: outside the FOV
 	EXPECT_EQ(fx.sf.scene.object(8)->category, Category::Small);
 	// a board above the robot height blocks nothing
 	int bx, by;
@@ -89,7 +89,7 @@ TEST(SimGroundTruth, LabelsIdsAndCategories)
 	// outside the field of view: unobserved (behind the robot, far to the side)
 	EXPECT_EQ(gt.labelAt(-0.8, 0.0), Label::Unobserved);
 	EXPECT_EQ(gt.labelAt(1.0, 2.9), Label::Unobserved);
-	EXPECT_EQ(gt.labelAt(9.0, 0.0), Label::Unobserved);	 // outside the grid
+	EXPECT_EQ(gt.labelAt(9.0, 0.0), Label::Unobserved);  // outside the grid
 }
 
 TEST(SimGroundTruth, CellEdgesAreConservative)

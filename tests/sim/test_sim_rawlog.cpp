@@ -7,11 +7,11 @@
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CRawlog.h>
 
+#include <unistd.h>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -122,7 +122,7 @@ TEST(SimRawlog, GamSimulateWritesALoadableRawlog)
 	}
 	EXPECT_GT(nFloor, 50000u);
 	EXPECT_GT(nFace, 1000u);
-	EXPECT_LT(maxFloorErr, 0.005);	// 1 mm depth quantisation
+	EXPECT_LT(maxFloorErr, 0.005);  // 1 mm depth quantisation
 	EXPECT_LT(maxFaceErr, 0.002);
 }
 

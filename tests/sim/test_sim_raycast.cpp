@@ -151,10 +151,18 @@ TEST(SimScene, ParserErrorsNameFileAndLine)
 	};
 	EXPECT_NE(err("path waypoints=0,0,0\n# c\nbox id=1 x=1 sx=1 sy=1 sz=1\n").find("bad.scene:3"), std::string::npos);
 	EXPECT_NE(err("path waypoints=0,0,0\nbox id=1 x=1 sx=1 sy=1 sz=1\n").find("missing y="), std::string::npos);
-	EXPECT_NE(err("path waypoints=0,0,0\nbox id=1 x=1 y=0 sx=1 sy=1 sz=1 colour=red\n").find("unknown key 'colour'"), std::string::npos);
-	EXPECT_NE(err("path waypoints=0,0,0\nbox id=1 x=1 y=0 sx=1 sy=1 sz=1\nbox id=1 x=3 y=0 sx=1 sy=1 sz=1\n").find("bad.scene:3: box: duplicate id 1"), std::string::npos);
-	EXPECT_NE(err("path waypoints=0,0,0\nspaceship id=1\n").find("bad.scene:2: unknown statement 'spaceship'"), std::string::npos);
-	EXPECT_NE(err("path waypoints=0,0,0\nbox id=1 x=abc y=0 sx=1 sy=1 sz=1\n").find("bad number for x"), std::string::npos);
+	EXPECT_NE(
+		err("path waypoints=0,0,0\nbox id=1 x=1 y=0 sx=1 sy=1 sz=1 colour=red\n").find("unknown key 'colour'"),
+		std::string::npos);
+	EXPECT_NE(
+		err("path waypoints=0,0,0\nbox id=1 x=1 y=0 sx=1 sy=1 sz=1\nbox id=1 x=3 y=0 sx=1 sy=1 sz=1\n")
+			.find("bad.scene:3: box: duplicate id 1"),
+		std::string::npos);
+	EXPECT_NE(
+		err("path waypoints=0,0,0\nspaceship id=1\n").find("bad.scene:2: unknown statement 'spaceship'"),
+		std::string::npos);
+	EXPECT_NE(
+		err("path waypoints=0,0,0\nbox id=1 x=abc y=0 sx=1 sy=1 sz=1\n").find("bad number for x"), std::string::npos);
 	EXPECT_NE(err("box id=1 x=1 y=0 sx=1 sy=1 sz=1\n").find("no 'path'"), std::string::npos);
 	EXPECT_NE(err("path waypoints=0,0,0\nkinect pose=1,2,3\n").find("pose needs 6"), std::string::npos);
 	EXPECT_EQ(err("path waypoints=0,0,0;1,0,0 spacing=0.1\n"), "");

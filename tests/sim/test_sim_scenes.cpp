@@ -30,16 +30,17 @@ TEST(SimScenes, BundledScenesParseAndLabelEveryObject)
 		std::set<int> seen(gt.objectId.begin(), gt.objectId.end());
 		for (const auto& o : sf.scene.objects)
 		{
-			const bool matters = (o.bbox.max().z() > sf.grid.obstacle_min_height ||
-								  o.bbox.min().z() < -sf.grid.drop_min_depth) &&
-								 o.bbox.min().z() < sf.grid.robot_height;
+			const bool matters =
+				(o.bbox.max().z() > sf.grid.obstacle_min_height || o.bbox.min().z() < -sf.grid.drop_min_depth) &&
+				o.bbox.min().z() < sf.grid.robot_height;
 			if (matters)
 			{
 				EXPECT_TRUE(seen.count(o.id)) << o.name;
 			}
 		}
 	}
-	for (const char* s : {"demo", "floor_outlets", "downward_stairs", "cable_protector", "small_boxes",
-						  "table", "ramp_6deg", "tilted_rolled_mount", "office_traverse", "no_floor"})
+	for (const char* s :
+		 {"demo", "floor_outlets", "downward_stairs", "cable_protector", "small_boxes", "table", "ramp_6deg",
+		  "tilted_rolled_mount", "office_traverse", "no_floor"})
 		EXPECT_TRUE(names.count(s)) << s;
 }

@@ -48,7 +48,7 @@ TEST(SimKinect, NoiseOffGivesExactDepth)
 	// a known pixel ray: floor 1 m below a camera pitched 45 deg down, centre pixel
 	SceneFile fl = parse("");
 	kp.width = 5;
-	kp.height = 5;	// centre pixel exactly on the optical axis
+	kp.height = 5;  // centre pixel exactly on the optical axis
 	KinectModel small(kp);
 	const DepthFrame g = small.render(fl.scene, Pose3::fromXYZYPR(0, 0, 1, 0, 45 * kDeg, 0), rng);
 	EXPECT_NEAR(g.depth[g.idx(2, 2)], std::sqrt(2.0), 1e-6);

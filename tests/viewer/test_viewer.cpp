@@ -73,15 +73,17 @@ class Viewer : public ::testing::Test
 		fs::create_directories(kTmp);
 		rawlog = kTmp + "/nav.rawlog";
 		std::string out;
-		ASSERT_EQ(run(std::string(GAM_SIMULATE_EXE) + " --scene " + GAM_SOURCE_DIR +
-						  "/config/scenes/nav_hole.scene --out " + kTmp + "/nav --no-leddar",
-					  &out),
-				  0)
+		ASSERT_EQ(
+			run(std::string(GAM_SIMULATE_EXE) + " --scene " + GAM_SOURCE_DIR + "/config/scenes/nav_hole.scene --out " +
+					kTmp + "/nav --no-leddar",
+				&out),
+			0)
 			<< out;
 		shots = kTmp + "/shots";
-		batchRc = run(std::string(GAM_VIEWER_EXE) + " " + rawlog + " --screenshot-dir " + shots +
-						  " --frame 10 --exit --width 640 --height 480",
-					  &batchOut);
+		batchRc =
+			run(std::string(GAM_VIEWER_EXE) + " " + rawlog + " --screenshot-dir " + shots +
+					" --frame 10 --exit --width 640 --height 480",
+				&batchOut);
 		model = std::make_unique<ViewerModel>();
 		model->openRawlog(rawlog);
 		model->seek(10);
@@ -173,7 +175,7 @@ TEST_F(Viewer, ParameterChangeRerunsTheCurrentFrame)
 	const size_t nodes = m.groundAware().lastFrame().detection.nodes.size();
 	ASSERT_GT(nodes, 20u);
 	auto o = m.groundOptions();
-	o.pipeline.rrt.iterations = 20;	 // K: far fewer RRT iterations
+	o.pipeline.rrt.iterations = 20;  // K: far fewer RRT iterations
 	m.applyGroundOptions(o);
 	EXPECT_EQ(m.current(), 5);
 	EXPECT_LT(m.groundAware().lastFrame().detection.nodes.size(), nodes);
@@ -213,7 +215,10 @@ TEST_F(Viewer, BadArgumentsFail)
 {
 	std::string out;
 	EXPECT_EQ(run(std::string(GAM_VIEWER_EXE) + " --exit --screenshot-dir " + kTmp + "/x", &out), 2) << out;
-	EXPECT_EQ(run(std::string(GAM_VIEWER_EXE) + " " + kTmp + "/missing.rawlog --exit --screenshot-dir " + kTmp + "/x", &out), 1) << out;
+	EXPECT_EQ(
+		run(std::string(GAM_VIEWER_EXE) + " " + kTmp + "/missing.rawlog --exit --screenshot-dir " + kTmp + "/x", &out),
+		1)
+		<< out;
 	EXPECT_NE(out.find("ground-aware-viewer: error:"), std::string::npos) << out;
 }
 
@@ -222,9 +227,10 @@ TEST_F(Viewer, GuiStartsEditsAParameterAndDrawsUnderXvfb)
 	if (run("command -v xvfb-run") != 0) GTEST_SKIP() << "xvfb-run not installed";
 	const std::string png = kTmp + "/gui.png";
 	std::string out;
-	const int rc = run("xvfb-run -a -s '-screen 0 1400x900x24' " + std::string(GAM_VIEWER_EXE) + " " +
-						   rawlog + " --frame 5 --gui-snapshot " + png,
-					   &out);
+	const int rc =
+		run("xvfb-run -a -s '-screen 0 1400x900x24' " + std::string(GAM_VIEWER_EXE) + " " + rawlog +
+				" --frame 5 --gui-snapshot " + png,
+			&out);
 	ASSERT_EQ(rc, 0) << out;
 	EXPECT_NE(out.find("gui: K=100 applied"), std::string::npos) << out;
 	EXPECT_NE(out.find("gui: snapshot written"), std::string::npos) << out;

@@ -13,8 +13,7 @@
 
 using namespace mrpt::maps;
 
-MAP_DEFINITION_REGISTER(
-	"mrpt::maps::CHeightBandOccupancyGrid,heightBandGrid", mrpt::maps::CHeightBandOccupancyGrid)
+MAP_DEFINITION_REGISTER("mrpt::maps::CHeightBandOccupancyGrid,heightBandGrid", mrpt::maps::CHeightBandOccupancyGrid)
 IMPLEMENTS_SERIALIZABLE(CHeightBandOccupancyGrid, COccupancyGridMap2D, mrpt::maps)
 
 namespace
@@ -61,8 +60,7 @@ void CHeightBandOccupancyGrid::TMapDefinition::dumpToTextStream_map_specific(std
 	bandOpts.dumpToTextStream(out);
 }
 
-mrpt::maps::CMetricMap* CHeightBandOccupancyGrid::internal_CreateFromMapDefinition(
-	const TMetricMapInitializer& _def)
+mrpt::maps::CMetricMap* CHeightBandOccupancyGrid::internal_CreateFromMapDefinition(const TMetricMapInitializer& _def)
 {
 	const auto& def = dynamic_cast<const CHeightBandOccupancyGrid::TMapDefinition&>(_def);
 	auto* m = new CHeightBandOccupancyGrid(def.min_x, def.max_x, def.min_y, def.max_y, def.resolution);
@@ -92,8 +90,7 @@ void CHeightBandOccupancyGrid::THeightBandOptions::validate() const
 }
 
 // ---------------------------------------------------------------------------
-CHeightBandOccupancyGrid::CHeightBandOccupancyGrid(
-	float min_x, float max_x, float min_y, float max_y, float resolution)
+CHeightBandOccupancyGrid::CHeightBandOccupancyGrid(float min_x, float max_x, float min_y, float max_y, float resolution)
 	: COccupancyGridMap2D(min_x, max_x, min_y, max_y, resolution)
 {
 	insertionOptions.considerInvalidRangesAsFreeSpace = false;
@@ -103,8 +100,8 @@ CHeightBandOccupancyGrid::CHeightBandOccupancyGrid(
 std::string CHeightBandOccupancyGrid::asString() const
 {
 	std::ostringstream s;
-	s << "CHeightBandOccupancyGrid " << getSizeX() << "x" << getSizeY() << " cells at "
-	  << getResolution() << " m, band z[" << bandOptions.z_min << "," << bandOptions.z_max << "]";
+	s << "CHeightBandOccupancyGrid " << getSizeX() << "x" << getSizeY() << " cells at " << getResolution()
+	  << " m, band z[" << bandOptions.z_min << "," << bandOptions.z_max << "]";
 	return s.str();
 }
 
@@ -154,8 +151,7 @@ void CHeightBandOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in, 
 {
 	switch (version)
 	{
-		case 0:
-		{
+		case 0: {
 			uint8_t baseVer;
 			in >> baseVer;
 			COccupancyGridMap2D::serializeFrom(in, baseVer);

@@ -10,13 +10,13 @@
 #include <mrpt/opengl/COctoMapVoxels.h>
 #include <mrpt/serialization/CArchive.h>
 
-#include <chrono>
-#include <cstdio>
-#include <iostream>
-#include <filesystem>
-#include <unistd.h>
 #include <fcntl.h>
+#include <unistd.h>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 
@@ -155,9 +155,9 @@ void COctoMapGrid2D::applyOctoOptions()
 std::string COctoMapGrid2D::asString() const
 {
 	std::ostringstream s;
-	s << "COctoMapGrid2D " << getSizeX() << "x" << getSizeY() << " cells at " << getResolution()
-	  << " m; octomap voxel " << m_octomap.getResolution() << " m, " << m_octomap.getNumLeafNodes()
-	  << " leaves; band z[" << octoOptions.z_min << "," << octoOptions.z_max << "]";
+	s << "COctoMapGrid2D " << getSizeX() << "x" << getSizeY() << " cells at " << getResolution() << " m; octomap voxel "
+	  << m_octomap.getResolution() << " m, " << m_octomap.getNumLeafNodes() << " leaves; band z[" << octoOptions.z_min
+	  << "," << octoOptions.z_max << "]";
 	return s.str();
 }
 
@@ -204,8 +204,8 @@ bool COctoMapGrid2D::internal_insertObservation(
 			T3DPointsProjectionParams pp;
 			pp.takeIntoAccountSensorPoseOnRobot = true;
 			pp.robotPoseInTheWorld = pose;
-			pp.decimation = uint8_t(largestDivisorAtMost(
-				octoOptions.decimation, int(tmp.rangeImage.cols()), int(tmp.rangeImage.rows())));
+			pp.decimation = uint8_t(
+				largestDivisorAtMost(octoOptions.decimation, int(tmp.rangeImage.cols()), int(tmp.rangeImage.rows())));
 			tmp.unprojectInto(pts, pp);
 		}
 		else
@@ -308,7 +308,7 @@ void COctoMapGrid2D::updateProjection()
 			for (int cx = std::max(0, cx0); cx <= std::min(sx - 1, cx1); cx++)
 			{
 				cellType& c = m_map[size_t(cx) + size_t(cy) * size_t(sx)];
-				if (value < 0 || c == 0) c = value;	 // occupied wins over free
+				if (value < 0 || c == 0) c = value;  // occupied wins over free
 			}
 	};
 	if (octoOptions.mark_free && VOXEL_SET_FREESPACE < vox.getVoxelSetCount())
@@ -323,13 +323,12 @@ void COctoMapGrid2D::updateProjection()
 		for (size_t i = 0; i < vox.getVoxelCount(VOXEL_SET_OCCUPIED); i++)
 		{
 			const auto& v = vox.getVoxel(VOXEL_SET_OCCUPIED, i);
-			if (v.coords.z < zlo || v.coords.z > zhi) continue;	 // octomap_server: centre in band
+			if (v.coords.z < zlo || v.coords.z > zhi) continue;  // octomap_server: centre in band
 			paint(v, OCCGRID_CELLTYPE_MIN);
 		}
 	m_is_empty = false;
 	m_likelihoodCacheOutDated = true;
-	m_lastProjectionMs =
-		std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+	m_lastProjectionMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 void COctoMapGrid2D::saveMetricMapRepresentationToFile(const std::string& prefix) const
@@ -357,8 +356,7 @@ void COctoMapGrid2D::serializeFrom(mrpt::serialization::CArchive& in, uint8_t ve
 {
 	switch (version)
 	{
-		case 0:
-		{
+		case 0: {
 			uint8_t baseVer;
 			in >> baseVer;
 			COccupancyGridMap2D::serializeFrom(in, baseVer);

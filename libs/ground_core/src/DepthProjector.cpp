@@ -12,16 +12,12 @@ void PinholeIntrinsics::validate() const
 {
 	if (width <= 0 || height <= 0)
 		throw std::invalid_argument(
-			"camera size must be positive (got " + std::to_string(width) + "x" +
-			std::to_string(height) + ")");
+			"camera size must be positive (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
 	if (!(fx > 0) || !(fy > 0) || !std::isfinite(fx) || !std::isfinite(fy))
 		throw std::invalid_argument(
-			"camera focal lengths must be > 0 (got fx=" + std::to_string(fx) +
-			", fy=" + std::to_string(fy) + ")");
-	if (!std::isfinite(cx) || !std::isfinite(cy))
-		throw std::invalid_argument("camera principal point must be finite");
-	if (!std::isfinite(k1) || !std::isfinite(k2) || !std::isfinite(k3) || !std::isfinite(p1) ||
-		!std::isfinite(p2))
+			"camera focal lengths must be > 0 (got fx=" + std::to_string(fx) + ", fy=" + std::to_string(fy) + ")");
+	if (!std::isfinite(cx) || !std::isfinite(cy)) throw std::invalid_argument("camera principal point must be finite");
+	if (!std::isfinite(k1) || !std::isfinite(k2) || !std::isfinite(k3) || !std::isfinite(p1) || !std::isfinite(p2))
 		throw std::invalid_argument("camera distortion coefficients must be finite");
 }
 
@@ -94,21 +90,18 @@ void projectRowDecimated(
 }  // namespace
 
 size_t DepthProjector::project(
-	const RangeImageView& img, const PinholeIntrinsics& K, const RigidTransform& T,
-	const ProjectionFilter& f, const ElevationGrid& grid, BinnedPoints& out)
+	const RangeImageView& img, const PinholeIntrinsics& K, const RigidTransform& T, const ProjectionFilter& f,
+	const ElevationGrid& grid, BinnedPoints& out)
 {
 	K.validate();
 	if (!img.data || img.rows <= 0 || img.cols <= 0) return 0;
 	if (img.rows != K.height || img.cols != K.width)
 		throw std::invalid_argument(
 			"range image is " + std::to_string(img.cols) + "x" + std::to_string(img.rows) +
-			" but the camera parameters say " + std::to_string(K.width) + "x" +
-			std::to_string(K.height));
+			" but the camera parameters say " + std::to_string(K.width) + "x" + std::to_string(K.height));
 	if (!(img.units > 0) || !std::isfinite(img.units))
-		throw std::invalid_argument(
-			"rangeUnits must be > 0 (got " + std::to_string(img.units) + ")");
-	if (!T.R.allFinite() || !T.t.allFinite())
-		throw std::invalid_argument("sensor pose is not finite");
+		throw std::invalid_argument("rangeUnits must be > 0 (got " + std::to_string(img.units) + ")");
+	if (!T.R.allFinite() || !T.t.allFinite()) throw std::invalid_argument("sensor pose is not finite");
 	updateLut(K);
 
 	detail::RowParams p;
@@ -117,8 +110,7 @@ size_t DepthProjector::project(
 	// Work in cell units relative to the grid origin: floats stay precise far
 	// from the map origin, and the cell index is just the integer part.
 	const Eigen::Matrix3f Rc = T.R * inv_res;
-	const Eigen::Vector3f tc =
-		(T.t - Eigen::Vector3f(float(g.x_min), float(g.y_min), 0.f)) * inv_res;
+	const Eigen::Vector3f tc = (T.t - Eigen::Vector3f(float(g.x_min), float(g.y_min), 0.f)) * inv_res;
 	for (int j = 0; j < 3; j++)
 	{
 		p.rx[j] = Rc(0, j);
@@ -157,14 +149,15 @@ size_t DepthProjector::project(
 		{
 			const float* invN = img.is_depth ? nullptr : &m_rayInvNorm[lutRow];
 			if (useAvx2)
-				detail::projectRowAvx2(img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
+				detail::projectRowAvx2(
+					img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
 			else
 				projectRow(img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
 		}
 		else
 			projectRowDecimated(
-				p, img.is_depth, row, &m_rayY[lutRow], &m_rayZ[lutRow], &m_rayInvNorm[lutRow], img.cols, dec,
-				rowCell, rowZ);
+				p, img.is_depth, row, &m_rayY[lutRow], &m_rayZ[lutRow], &m_rayInvNorm[lutRow], img.cols, dec, rowCell,
+				rowZ);
 		// Compaction: every pixel is written at outCell[n], only the valid ones
 		// advance n (branch-free: valid and invalid pixels interleave at random).
 		const int used = int(colsUsed);

@@ -14,16 +14,15 @@ bool avx2RowLoopAvailable()
 	return has;
 }
 void projectRowAvx2(
-	bool isDepth, const RowParams& p, const uint16_t* row, const float* ky, const float* kz,
-	const float* invNorm, int cols, int32_t* cell, float* z)
+	bool isDepth, const RowParams& p, const uint16_t* row, const float* ky, const float* kz, const float* invNorm,
+	int cols, int32_t* cell, float* z)
 {
 	projectRow(isDepth, p, row, ky, kz, invNorm, cols, cell, z);
 }
 #else
 bool avx2RowLoopAvailable() { return false; }
 void projectRowAvx2(
-	bool, const RowParams&, const uint16_t*, const float*, const float*, const float*, int, int32_t*,
-	float*)
+	bool, const RowParams&, const uint16_t*, const float*, const float*, const float*, int, int32_t*, float*)
 {
 }
 #endif

@@ -9,19 +9,16 @@ namespace gam
 void GridGeometry::validate() const
 {
 	if (!(resolution > 0) || !std::isfinite(resolution))
-		throw std::invalid_argument(
-			"grid resolution must be > 0 (got " + std::to_string(resolution) + ")");
+		throw std::invalid_argument("grid resolution must be > 0 (got " + std::to_string(resolution) + ")");
 	if (nx <= 0 || ny <= 0)
 		throw std::invalid_argument(
-			"grid size must be at least 1x1 cells (got " + std::to_string(nx) + "x" +
-			std::to_string(ny) + ")");
+			"grid size must be at least 1x1 cells (got " + std::to_string(nx) + "x" + std::to_string(ny) + ")");
 	// 2^26 cells = 1.5 GiB of ElevationCell: far beyond any sane 2.5D map.
 	if (double(nx) * double(ny) > double(1u << 26))
 		throw std::invalid_argument(
 			"grid of " + std::to_string(nx) + "x" + std::to_string(ny) +
 			" cells is too large (limit 67M cells); raise the resolution value or shrink the area");
-	if (!std::isfinite(x_min) || !std::isfinite(y_min))
-		throw std::invalid_argument("grid origin must be finite");
+	if (!std::isfinite(x_min) || !std::isfinite(y_min)) throw std::invalid_argument("grid origin must be finite");
 }
 
 void ElevationGrid::resize(const GridGeometry& g)
@@ -122,7 +119,7 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 		const float mean = a.ref + m1;
 		if (mean - lim <= a.z_min && mean + lim >= a.z_max) continue;
 		m_filterMean[c] = mean;
-		m_filterLimit[c] = lim;	 // finite = flagged
+		m_filterLimit[c] = lim;  // finite = flagged
 		a = FrameCell{};
 		flagged++;
 	}

@@ -17,19 +17,12 @@ double voxelDensity(uint32_t count, double span, double resolution)
 	const double h = std::max(span, resolution);
 	return double(count) / (resolution * resolution * h);
 }
-double densityConfidence(double rho, const IsmParams& p)
-{
-	return 1.0 / (1.0 + std::exp(-(p.K_n * rho - p.d_min)));
-}
+double densityConfidence(double rho, const IsmParams& p) { return 1.0 / (1.0 + std::exp(-(p.K_n * rho - p.d_min))); }
 double obstacleProbability(double pr, const IsmParams& p) { return 0.5 + 0.5 * p.K_m * pr; }
-double groundProbability(double d, const IsmParams& p)
-{
-	return 0.5 - p.K_g * std::exp(-d * d / (2.0 * p.sigma2));
-}
+double groundProbability(double d, const IsmParams& p) { return 0.5 - p.K_g * std::exp(-d * d / (2.0 * p.sigma2)); }
 }  // namespace ism
 
-double InverseSensorModel::groundBand(
-	const Eigen::Vector3d& sensor, double h, double x, double y, double z) const
+double InverseSensorModel::groundBand(const Eigen::Vector3d& sensor, double h, double x, double y, double z) const
 {
 	if (m_params.noise_sigmas <= 0) return m_params.d_pth;
 	const double dx = x - sensor.x(), dy = y - sensor.y(), dz = z - sensor.z();
@@ -146,8 +139,7 @@ const Plane& InverseSensorModel::choosePlane(
 	// fits best: a ramp voxel sits on the ramp, a box stands on both.
 	const Plane* best = &det.planes.front();
 	auto cost = [&](const Plane& pl) {
-		return std::max(
-			std::abs(pl.signedDistance(x, y, c.z_max)), std::abs(pl.signedDistance(x, y, c.z_min)));
+		return std::max(std::abs(pl.signedDistance(x, y, c.z_max)), std::abs(pl.signedDistance(x, y, c.z_min)));
 	};
 	double bestCost = cost(*best);
 	for (size_t k = 1; k < det.planes.size(); k++)
@@ -227,8 +219,7 @@ void InverseSensorModel::compute(
 				put(idx, float(ism::groundProbability(dMean, m_params)));
 				break;
 			case VoxelClass::Obstacle:
-			case VoxelClass::Drop:
-			{
+			case VoxelClass::Drop: {
 				if (c.count < uint32_t(std::max(1, m_params.min_obstacle_points)))
 				{
 					// A lone return (a depth spike) is no evidence of anything.

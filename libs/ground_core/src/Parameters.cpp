@@ -21,8 +21,8 @@ void checkParamRange(const ParamInfo& info, double value, const std::string& con
 	if (std::isfinite(value) && value >= info.lo && value <= info.hi) return;
 	std::ostringstream s;
 	if (!context.empty()) s << context << " ";
-	s << info.key << "=" << (shown.empty() ? number(value) : shown) << " is out of range " << number(info.lo)
-	  << " to " << number(info.hi);
+	s << info.key << "=" << (shown.empty() ? number(value) : shown) << " is out of range " << number(info.lo) << " to "
+	  << number(info.hi);
 	if (info.help && *info.help) s << " (" << info.help << ")";
 	throw std::invalid_argument(s.str());
 }

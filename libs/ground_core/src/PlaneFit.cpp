@@ -85,8 +85,8 @@ std::optional<RansacResult> fitPlaneRansac(
 }
 
 bool fitPlaneRansac(
-	const std::vector<Eigen::Vector3d>& pts, const RansacParams& p, std::mt19937& rng,
-	RansacResult& res, std::vector<Eigen::Vector3d>& inl)
+	const std::vector<Eigen::Vector3d>& pts, const RansacParams& p, std::mt19937& rng, RansacResult& res,
+	std::vector<Eigen::Vector3d>& inl)
 {
 	const size_t n = pts.size();
 	if (n < 3 || n < p.min_inliers) return false;

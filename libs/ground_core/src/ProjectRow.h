@@ -34,19 +34,18 @@ namespace
 using detail::RowParams;
 // One pixel: its grid cell (-1 if it is dropped) and its height.
 template <bool kDepth>
-inline void projectPixel(
-	const RowParams& p, uint16_t raw, float ky, float kz, float invNorm, int32_t& cell, float& z)
+inline void projectPixel(const RowParams& p, uint16_t raw, float ky, float kz, float invNorm, int32_t& cell, float& z)
 {
 	const float v = float(raw) * p.units;  // 0 = no return: fails v > 0 below
 	const float D = kDepth ? v : v * invNorm;
 	// Sensor-frame point (D, D*ky, D*kz) mapped to the grid frame.
 	const float sy = D * ky, sz = D * kz;
-	const float fx = p.rx[0] * D + p.rx[1] * sy + p.rx[2] * sz + p.t[0];	// cells
+	const float fx = p.rx[0] * D + p.rx[1] * sy + p.rx[2] * sz + p.t[0];  // cells
 	const float fy = p.ry[0] * D + p.ry[1] * sy + p.ry[2] * sz + p.t[1];
-	const float gz = p.rz[0] * D + p.rz[1] * sy + p.rz[2] * sz + p.t[2];	// metres
+	const float gz = p.rz[0] * D + p.rz[1] * sy + p.rz[2] * sz + p.t[2];  // metres
 	// Written so that NaN fails every comparison.
-	const bool ok = (v > 0.f) & (v >= p.min_range) & (v <= p.max_range) & (gz >= p.z_min) &
-					(gz <= p.z_max) & (fx >= 0.f) & (fy >= 0.f) & (fx < p.nx) & (fy < p.ny);
+	const bool ok = (v > 0.f) & (v >= p.min_range) & (v <= p.max_range) & (gz >= p.z_min) & (gz <= p.z_max) &
+					(fx >= 0.f) & (fy >= 0.f) & (fx < p.nx) & (fy < p.ny);
 	// int() of a value outside the int range is UB: convert only in-grid values.
 	const int32_t cx = int32_t(ok ? fx : 0.f), cy = int32_t(ok ? fy : 0.f);
 	cell = ok ? cy * p.nx_cells + cx : -1;
@@ -56,9 +55,8 @@ inline void projectPixel(
 // A full row: no branches and unit strides, so the compiler vectorizes it.
 template <bool kDepth>
 void projectRowLoop(
-	const RowParams& p, const uint16_t* __restrict row, const float* __restrict ky,
-	const float* __restrict kz, const float* __restrict invNorm, int cols, int32_t* __restrict cell,
-	float* __restrict z)
+	const RowParams& p, const uint16_t* __restrict row, const float* __restrict ky, const float* __restrict kz,
+	const float* __restrict invNorm, int cols, int32_t* __restrict cell, float* __restrict z)
 {
 	for (int c = 0; c < cols; c++)
 		projectPixel<kDepth>(p, row[c], ky[c], kz[c], kDepth ? 1.f : invNorm[c], cell[c], z[c]);
@@ -66,8 +64,8 @@ void projectRowLoop(
 
 // The row loop for a depth image (invNorm unused) or a range image.
 inline void projectRow(
-	bool isDepth, const RowParams& p, const uint16_t* row, const float* ky, const float* kz,
-	const float* invNorm, int cols, int32_t* cell, float* z)
+	bool isDepth, const RowParams& p, const uint16_t* row, const float* ky, const float* kz, const float* invNorm,
+	int cols, int32_t* cell, float* z)
 {
 	if (isDepth)
 		projectRowLoop<true>(p, row, ky, kz, invNorm, cols, cell, z);

@@ -39,8 +39,8 @@ std::string GroundDetection::describe() const
 	if (!planes.empty())
 	{
 		const Plane& p = planes.front();
-		s << "; ground " << p.a << "x + " << p.b << "y + " << p.c << "z + " << p.d
-		  << " = 0 (tilt " << p.tiltAngle() * 180.0 / M_PI << " deg)";
+		s << "; ground " << p.a << "x + " << p.b << "y + " << p.c << "z + " << p.d << " = 0 (tilt "
+		  << p.tiltAngle() * 180.0 / M_PI << " deg)";
 	}
 	return s.str();
 }
@@ -58,8 +58,7 @@ bool RrtGroundDetector::cellHeight(const ElevationGrid& grid, int cx, int cy, fl
 	return !std::isnan(z);
 }
 
-bool RrtGroundDetector::fitLocalPlane(
-	const ElevationGrid& grid, int cx, int cy, Plane& plane, double& rms) const
+bool RrtGroundDetector::fitLocalPlane(const ElevationGrid& grid, int cx, int cy, Plane& plane, double& rms) const
 {
 	const GridGeometry& g = grid.geometry();
 	const int hx = m_params.neighbourhood_x / 2, hy = m_params.neighbourhood_y / 2;
@@ -76,18 +75,16 @@ bool RrtGroundDetector::fitLocalPlane(
 	const auto p = fitHeightPlaneLeastSquares(m_fitPts, &rms);
 	if (!p) return false;
 	// Move the plane from centre-relative to grid coordinates.
-	plane = Plane::fromNormalAndPoint(
-		p->normal(), Eigen::Vector3d(g.cx(cx), g.cy(cy), p->heightAt(0, 0)));
+	plane = Plane::fromNormalAndPoint(p->normal(), Eigen::Vector3d(g.cx(cx), g.cy(cy), p->heightAt(0, 0)));
 	return true;
 }
 
-bool RrtGroundDetector::findSeed(
-	const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed)
+bool RrtGroundDetector::findSeed(const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed)
 {
 	const GridGeometry& g = grid.geometry();
 	// No seed can lie farther than the grid reaches: cap the offset table.
-	const int R = std::max(
-		1, int(std::min<double>(std::ceil(m_params.seed_search_radius / g.resolution), std::max(g.nx, g.ny))));
+	const int R =
+		std::max(1, int(std::min<double>(std::ceil(m_params.seed_search_radius / g.resolution), std::max(g.nx, g.ny))));
 	if (R != m_ringRadius)
 	{
 		// Cell offsets within the radius, nearest first.
@@ -95,11 +92,9 @@ bool RrtGroundDetector::findSeed(
 		for (int dy = -R; dy <= R; dy++)
 			for (int dx = -R; dx <= R; dx++)
 				if (dx * dx + dy * dy <= R * R) m_ringOffsets.emplace_back(dx, dy);
-		std::stable_sort(
-			m_ringOffsets.begin(), m_ringOffsets.end(), [](const auto& a, const auto& b) {
-				return a.first * a.first + a.second * a.second <
-					   b.first * b.first + b.second * b.second;
-			});
+		std::stable_sort(m_ringOffsets.begin(), m_ringOffsets.end(), [](const auto& a, const auto& b) {
+			return a.first * a.first + a.second * a.second < b.first * b.first + b.second * b.second;
+		});
 		m_ringRadius = R;
 	}
 	const int rx = g.ix(hint.x), ry = g.iy(hint.y);
@@ -108,7 +103,7 @@ bool RrtGroundDetector::findSeed(
 		const int cx = rx + dx, cy = ry + dy;
 		if (!g.inside(cx, cy)) continue;
 		const ElevationCell& c = grid.cell(cx, cy);
-		if (!c.count) continue;	 // the seed must be a real observation
+		if (!c.count) continue;  // the seed must be a real observation
 		if (!m_seedExcluded.empty() && m_seedExcluded[g.index(cx, cy)]) continue;
 		float z;
 		if (!cellHeight(grid, cx, cy, z)) continue;
@@ -116,8 +111,7 @@ bool RrtGroundDetector::findSeed(
 		Plane pl;
 		double rms;
 		if (!fitLocalPlane(grid, cx, cy, pl, rms)) continue;
-		if (rms > m_params.max_fit_rms || pl.horizontalNormal() > m_params.normal_threshold)
-			continue;
+		if (rms > m_params.max_fit_rms || pl.horizontalNormal() > m_params.normal_threshold) continue;
 		seed.x = float(g.cx(cx));
 		seed.y = float(g.cy(cy));
 		seed.z = float(pl.heightAt(seed.x, seed.y));
@@ -128,8 +122,7 @@ bool RrtGroundDetector::findSeed(
 	return false;
 }
 
-void RrtGroundDetector::detect(
-	const ElevationGrid& grid, const GroundSeedHint& hint, GroundDetection& out)
+void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& hint, GroundDetection& out)
 {
 	out.clear();
 	if (grid.observedCount() == 0)
@@ -175,8 +168,7 @@ void RrtGroundDetector::detect(
 		return;
 	}
 	fitPlanes(out);
-	out.status = out.planes.empty() ? GroundDetection::Status::NoConsensus
-									: GroundDetection::Status::Ok;
+	out.status = out.planes.empty() ? GroundDetection::Status::NoConsensus : GroundDetection::Status::Ok;
 }
 
 size_t RrtGroundDetector::maxTreeNodes(const GridGeometry& g) const
@@ -337,7 +329,7 @@ void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& se
 
 		float nearD2 = 0;
 		const uint32_t nearIdx = nodeIndexNearest(out.nodes, float(qx), float(qy), nearD2);
-		const GroundNode near = out.nodes[nearIdx];	 // copy: push_back may reallocate
+		const GroundNode near = out.nodes[nearIdx];  // copy: push_back may reallocate
 
 		const double dist = std::sqrt(double(nearD2));
 		if (dist < 1e-9) continue;
@@ -352,13 +344,11 @@ void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& se
 		const double px = g.cx(cx), py = g.cy(cy);
 		// Elevation test against the parent's local plane (lets the tree climb
 		// gentle ramps, stops it at steps, boxes and drops).
-		if (std::abs(double(z) - near.local.heightAt(px, py)) > m_params.elevation_threshold)
-			continue;
+		if (std::abs(double(z) - near.local.heightAt(px, py)) > m_params.elevation_threshold) continue;
 		Plane pl;
 		double rms;
 		if (!fitLocalPlane(grid, cx, cy, pl, rms)) continue;
-		if (rms > m_params.max_fit_rms || pl.horizontalNormal() > m_params.normal_threshold)
-			continue;
+		if (rms > m_params.max_fit_rms || pl.horizontalNormal() > m_params.normal_threshold) continue;
 
 		GroundNode node;
 		node.x = float(px);
@@ -404,8 +394,7 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 
 	for (int k = 0; k < m_params.max_planes && remaining.size() >= 3; k++)
 	{
-		rp.min_inliers = k == 0 ? std::max<size_t>(3, m_params.min_nodes / 2)
-								: m_params.min_nodes_per_extra_plane;
+		rp.min_inliers = k == 0 ? std::max<size_t>(3, m_params.min_nodes / 2) : m_params.min_nodes_per_extra_plane;
 		if (k > 0 && m_params.min_nodes_per_extra_plane == 0) break;
 		pts.clear();
 		for (size_t i : remaining) pts.emplace_back(out.nodes[i].x, out.nodes[i].y, out.nodes[i].z);
@@ -426,7 +415,8 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 			C += d * d.transpose();
 		}
 		C /= double(r.inliers.size());
-		const double minorStd = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(C).eigenvalues()(0)));
+		const double minorStd =
+			std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(C).eigenvalues()(0)));
 		// An extra patch must be an area, not a line of nodes along the top of
 		// a cable protector or a kerb: those are obstacles, not ground.
 		const bool lineLike = minorStd < 0.25 * m_params.expansion_distance;

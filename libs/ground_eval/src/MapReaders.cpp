@@ -67,8 +67,7 @@ void readCsv(const std::string& path, HeaderOk headerOk, const char* expected, O
 	std::ifstream f(path);
 	if (!f) throw Error("cannot open " + path);
 	std::string line;
-	if (!std::getline(f, line) || !headerOk(line))
-		throw Error(path + ": bad header (expected " + expected + ")");
+	if (!std::getline(f, line) || !headerOk(line)) throw Error(path + ": bad header (expected " + expected + ")");
 	int ln = 1;
 	while (std::getline(f, line))
 	{
@@ -166,18 +165,6 @@ bool labelFromName(const std::string& name, Label& l)
 	return false;
 }
 }  // namespace
-
-const char* labelName(Label l)
-{
-	switch (l)
-	{
-		case Label::Free: return "free";
-		case Label::Obstacle: return "obstacle";
-		case Label::Drop: return "drop";
-		case Label::Unobserved: return "unobserved";
-	}
-	return "?";
-}
 
 double RosMap::pOcc(int col, int rowFromBottom) const
 {
@@ -290,8 +277,9 @@ GroundTruth loadGroundTruth(const std::string& prefix)
 	if (rows.empty()) throw Error(lp + ": no cells");
 	const size_t n = size_t(gt.nx) * size_t(gt.ny);
 	if (rows.size() != n)
-		throw Error(lp + ": " + std::to_string(rows.size()) + " rows, expected " + std::to_string(gt.nx) + "x" +
-					std::to_string(gt.ny));
+		throw Error(
+			lp + ": " + std::to_string(rows.size()) + " rows, expected " + std::to_string(gt.nx) + "x" +
+			std::to_string(gt.ny));
 	gt.x.assign(n, std::nan(""));
 	gt.y.assign(n, std::nan(""));
 	gt.label.assign(n, Label::Unobserved);
@@ -299,7 +287,8 @@ GroundTruth loadGroundTruth(const std::string& prefix)
 	for (const auto& r : rows)
 	{
 		const size_t i = gt.idx(r.ix, r.iy);
-		if (!std::isnan(gt.x[i])) throw Error(lp + ": cell " + std::to_string(r.ix) + "," + std::to_string(r.iy) + " twice");
+		if (!std::isnan(gt.x[i]))
+			throw Error(lp + ": cell " + std::to_string(r.ix) + "," + std::to_string(r.iy) + " twice");
 		gt.x[i] = r.x;
 		gt.y[i] = r.y;
 		gt.label[i] = r.l;

@@ -29,9 +29,12 @@ std::string jsonStr(const std::string& s)
 	std::string o = "\"";
 	for (char c : s)
 	{
-		if (c == '"' || c == '\\') o += '\\', o += c;
-		else if ((unsigned char)c < 0x20) o += fmt("\\u%04x", double(int(c)));
-		else o += c;
+		if (c == '"' || c == '\\')
+			o += '\\', o += c;
+		else if ((unsigned char)c < 0x20)
+			o += fmt("\\u%04x", double(int(c)));
+		else
+			o += c;
 	}
 	return o + "\"";
 }
@@ -41,7 +44,8 @@ std::string catCell(const Reading& rd, const std::string& cat)
 	auto it = rd.categories.find(cat);
 	if (it == rd.categories.end() || it->second.objects == 0) return "-";
 	const auto& c = it->second;
-	return std::to_string(c.detected) + "/" + std::to_string(c.objects) + " (" + fmt("%.0f", 100 * c.meanCoverage()) + "%)";
+	return std::to_string(c.detected) + "/" + std::to_string(c.objects) + " (" + fmt("%.0f", 100 * c.meanCoverage()) +
+		   "%)";
 }
 
 std::string countsJson(const CellCounts& c)
@@ -102,18 +106,19 @@ std::string formatTable(const GroundTruth& gt, const std::vector<MapScore>& scor
 	  << " occupied observed cell(s), (coverage %); floor excludes cells within " << opt.tolerance_cells
 	  << " cell(s) of an obstacle/drop\n";
 	char b[512];
-	std::snprintf(b, sizeof(b), "%-14s %-10s %-12s %-12s %-12s %-12s %9s %9s %9s %11s\n", "map", "reading", "negative",
-				  "small", "overhang", "large", "floor_occ%", "floor_free%", "floor_unk%", "obst_cells%");
+	std::snprintf(
+		b, sizeof(b), "%-14s %-10s %-12s %-12s %-12s %-12s %9s %9s %9s %11s\n", "map", "reading", "negative", "small",
+		"overhang", "large", "floor_occ%", "floor_free%", "floor_unk%", "obst_cells%");
 	o << b;
 	for (const auto& s : scores)
 		for (const Reading* rd : {&s.main, &s.strict})
 		{
-			std::snprintf(b, sizeof(b), "%-14s %-10s %-12s %-12s %-12s %-12s %9.2f %11.2f %9.2f %11.2f\n",
-						  s.name.c_str(), rd->name.c_str(), catCell(*rd, "negative").c_str(),
-						  catCell(*rd, "small").c_str(), catCell(*rd, "overhang").c_str(),
-						  catCell(*rd, "large").c_str(), rd->floor.pct(rd->floor.occupied),
-						  rd->floor.pct(rd->floor.free), rd->floor.pct(rd->floor.unknown),
-						  rd->obstacle.pct(rd->obstacle.occupied));
+			std::snprintf(
+				b, sizeof(b), "%-14s %-10s %-12s %-12s %-12s %-12s %9.2f %11.2f %9.2f %11.2f\n", s.name.c_str(),
+				rd->name.c_str(), catCell(*rd, "negative").c_str(), catCell(*rd, "small").c_str(),
+				catCell(*rd, "overhang").c_str(), catCell(*rd, "large").c_str(), rd->floor.pct(rd->floor.occupied),
+				rd->floor.pct(rd->floor.free), rd->floor.pct(rd->floor.unknown),
+				rd->obstacle.pct(rd->obstacle.occupied));
 			o << b;
 		}
 	if (!scores.empty())
@@ -133,16 +138,18 @@ std::string toJson(const GroundTruth& gt, const std::vector<MapScore>& scores, c
 {
 	std::ostringstream o;
 	o << "{\n  \"ground_truth\": " << jsonStr(gt.prefix) << ",\n  \"gt_resolution\": " << fmt("%.6g", gt.resolution)
-	  << ",\n  \"gt_cells\": [" << gt.nx << ", " << gt.ny << "],\n  \"rules\": {\"tolerance_cells\": "
-	  << opt.tolerance_cells << ", \"min_hits\": " << std::max(1, opt.min_hits)
+	  << ",\n  \"gt_cells\": [" << gt.nx << ", " << gt.ny
+	  << "],\n  \"rules\": {\"tolerance_cells\": " << opt.tolerance_cells
+	  << ", \"min_hits\": " << std::max(1, opt.min_hits)
 	  << ", \"unknown_tolerance\": " << fmt("%.6g", opt.unknown_tolerance) << "},\n  \"maps\": [";
 	bool first = true;
 	for (const auto& s : scores)
 	{
-		o << (first ? "\n" : ",\n") << "    {\n      \"name\": " << jsonStr(s.name) << ",\n      \"yaml\": "
-		  << jsonStr(s.yamlPath) << ",\n      \"floor_cells_in_tolerance_band\": " << s.excluded_floor
-		  << ",\n      \"main\": " << readingJson(s.main, "      ") << ",\n      \"map_server\": "
-		  << readingJson(s.strict, "      ") << "\n    }";
+		o << (first ? "\n" : ",\n") << "    {\n      \"name\": " << jsonStr(s.name)
+		  << ",\n      \"yaml\": " << jsonStr(s.yamlPath)
+		  << ",\n      \"floor_cells_in_tolerance_band\": " << s.excluded_floor
+		  << ",\n      \"main\": " << readingJson(s.main, "      ")
+		  << ",\n      \"map_server\": " << readingJson(s.strict, "      ") << "\n    }";
 		first = false;
 	}
 	o << "\n  ]\n}\n";
@@ -161,7 +168,8 @@ std::string toCsv(const std::vector<MapScore>& scores)
 				o << pre << "object," << ob.id << "," << ob.category << "," << ob.observed << "," << ob.occupied << ","
 				  << ob.free << "," << ob.unknown << "," << (ob.detected ? 1 : 0) << "\n";
 			auto cc = [&](const char* rec, const CellCounts& c) {
-				o << pre << rec << ",0,none," << c.n << "," << c.occupied << "," << c.free << "," << c.unknown << ",0\n";
+				o << pre << rec << ",0,none," << c.n << "," << c.occupied << "," << c.free << "," << c.unknown
+				  << ",0\n";
 			};
 			cc("floor", rd->floor);
 			cc("ramp", rd->ramp);

@@ -66,8 +66,10 @@ std::vector<CellState> classify(const Resampled& r, double occ, double fr)
 	std::vector<CellState> s(r.pMax.size(), CellState::Unknown);
 	for (size_t i = 0; i < s.size(); i++)
 	{
-		if (r.pMax[i] > occ) s[i] = CellState::Occupied;
-		else if (r.pMin[i] < fr) s[i] = CellState::Free;
+		if (r.pMax[i] > occ)
+			s[i] = CellState::Occupied;
+		else if (r.pMin[i] < fr)
+			s[i] = CellState::Free;
 	}
 	return s;
 }
@@ -78,9 +80,12 @@ namespace
 template <class Counts>
 void tally(Counts& c, CellState s)
 {
-	if (s == CellState::Occupied) c.occupied++;
-	else if (s == CellState::Free) c.free++;
-	else c.unknown++;
+	if (s == CellState::Occupied)
+		c.occupied++;
+	else if (s == CellState::Free)
+		c.free++;
+	else
+		c.unknown++;
 }
 
 void count(CellCounts& c, CellState s)
@@ -92,8 +97,7 @@ void count(CellCounts& c, CellState s)
 bool isObstacle(Label l) { return l == Label::Obstacle || l == Label::Drop; }
 
 Reading score(
-	const GroundTruth& gt, const std::vector<CellState>& st, const std::vector<uint8_t>& floorMask,
-	const Options& opt)
+	const GroundTruth& gt, const std::vector<CellState>& st, const std::vector<uint8_t>& floorMask, const Options& opt)
 {
 	Reading rd;
 	std::map<int, ObjectScore> objs;
@@ -155,8 +159,10 @@ MapScore evaluate(const GroundTruth& gt, const RosMap& map, const Options& opt)
 					if (x < 0 || y < 0 || x >= gt.nx || y >= gt.ny) continue;
 					near = isObstacle(gt.label[gt.idx(x, y)]);
 				}
-			if (near) ms.excluded_floor++;
-			else floorMask[i] = 1;
+			if (near)
+				ms.excluded_floor++;
+			else
+				floorMask[i] = 1;
 		}
 	const Resampled r = resample(gt, map);
 	const double u = opt.unknown_tolerance;

@@ -26,9 +26,8 @@ std::string firstLine(const std::string& s) { return conciseError(s); }
 bool validLabel(const std::string& l)
 {
 	if (l.empty() || l[0] == '.' || l.size() > 100) return false;
-	return std::all_of(l.begin(), l.end(), [](char c) {
-		return std::isalnum((unsigned char)c) || c == '_' || c == '-' || c == '.';
-	});
+	return std::all_of(
+		l.begin(), l.end(), [](char c) { return std::isalnum((unsigned char)c) || c == '_' || c == '-' || c == '.'; });
 }
 
 /** Read-only view of a config that records every (section, key) read. */
@@ -84,11 +83,13 @@ void checkSections(
 		std::vector<std::string> secKeys;
 		ini.getAllKeys(sec, secKeys);
 		for (const auto& k : secKeys)
-			if (std::none_of(it->keys.begin(), it->keys.end(), [&](const std::string& a) { return gam::iequals(a, k); }))
+			if (std::none_of(
+					it->keys.begin(), it->keys.end(), [&](const std::string& a) { return gam::iequals(a, k); }))
 			{
 				std::string accepted;
 				for (const auto& a : it->keys) accepted += (accepted.empty() ? "" : " ") + a;
-				throw ConfigError("[" + sec + "] unknown key '" + k + "' (" + sp.className + " accepts: " + accepted + ")");
+				throw ConfigError(
+					"[" + sec + "] unknown key '" + k + "' (" + sp.className + " accepts: " + accepted + ")");
 			}
 	}
 }
@@ -96,8 +97,8 @@ void checkSections(
 
 // ---------------------------------------------------------------------------
 void loadMapDefinitions(
-	const mrpt::config::CConfigFileBase& iniIn, const std::string& section,
-	TSetOfMetricMapInitializers& inits, std::vector<MapSpec>& specs, std::vector<std::string>* warnings)
+	const mrpt::config::CConfigFileBase& iniIn, const std::string& section, TSetOfMetricMapInitializers& inits,
+	std::vector<MapSpec>& specs, std::vector<std::string>* warnings)
 {
 	RecordingConfig ini(iniIn);
 	mrpt::maps::registerGroundAwareMaps();
@@ -113,8 +114,7 @@ void loadMapDefinitions(
 	for (const auto& k : keys)
 	{
 		const std::string suffix = "_count";
-		if (k.size() <= suffix.size() || k.compare(k.size() - suffix.size(), suffix.size(), suffix) != 0)
-			continue;
+		if (k.size() <= suffix.size() || k.compare(k.size() - suffix.size(), suffix.size(), suffix) != 0) continue;
 		const std::string name = k.substr(0, k.size() - suffix.size());
 		if (reg.find(name) == reg.end())
 			throw ConfigError(
@@ -171,7 +171,8 @@ void loadMapDefinitions(
 				ini.getAllSections(sections);
 				for (const auto& sec : sections)
 				{
-					if (sec.size() <= sp.prefix.size() + 1 || gam::toLower(sec.substr(0, sp.prefix.size() + 1)) != gam::toLower(sp.prefix + "_"))
+					if (sec.size() <= sp.prefix.size() + 1 ||
+						gam::toLower(sec.substr(0, sp.prefix.size() + 1)) != gam::toLower(sp.prefix + "_"))
 						continue;
 					std::vector<std::string> secKeys;
 					ini.getAllKeys(sec, secKeys);
@@ -197,8 +198,7 @@ void loadMapDefinitions(
 			specs.push_back(sp);
 		}
 	}
-	if (specs.empty())
-		throw ConfigError("no maps defined in [" + section + "] (add e.g. groundAwareGrid_count=1)");
+	if (specs.empty()) throw ConfigError("no maps defined in [" + section + "] (add e.g. groundAwareGrid_count=1)");
 }
 
 }  // namespace gam::mapper

@@ -64,8 +64,8 @@ std::string RunSummary::text() const
 	s << "\n";
 	for (const auto& m : maps)
 	{
-		s << std::left << std::setw(int(wl) + 2) << m.label << std::setw(int(wc) + 2) << m.className
-		  << std::right << std::setw(12) << fmtMs(m.median()) << std::setw(12) << fmtMs(m.p95());
+		s << std::left << std::setw(int(wl) + 2) << m.label << std::setw(int(wc) + 2) << m.className << std::right
+		  << std::setw(12) << fmtMs(m.median()) << std::setw(12) << fmtMs(m.p95());
 		if (both)
 			s << std::setw(12) << fmtMs(percentile(m.ms2D, 0.5)) << std::setw(12) << fmtMs(percentile(m.ms2D, 0.95));
 		s << "\n";

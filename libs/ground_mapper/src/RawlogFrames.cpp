@@ -53,8 +53,7 @@ CArchive& operator>>(CArchive& in, std::string& str)
 	in.ReadBuffer(&n, sizeof(n));
 	constexpr uint32_t kLimit = 64u << 20;
 	if (n > kLimit)
-		throw std::runtime_error(
-			"corrupt data: a serialized string of " + std::to_string(n) + " bytes (limit 64 MiB)");
+		throw std::runtime_error("corrupt data: a serialized string of " + std::to_string(n) + " bytes (limit 64 MiB)");
 	str.resize(n);
 	if (n) in.ReadBuffer(&str[0], n);
 	return in;
@@ -85,7 +84,7 @@ class PeekStream : public mrpt::io::CStream
 			uint8_t tmp[256];
 			const size_t want = std::min(sizeof(tmp), n - (m_buf.size() - m_pos));
 			const size_t got = m_in.Read(tmp, want);
-			if (got == 0 || got > want) break;	// EOF or error
+			if (got == 0 || got > want) break;  // EOF or error
 			m_buf.insert(m_buf.end(), tmp, tmp + got);
 		}
 		return m_buf.size() - m_pos;
@@ -139,7 +138,7 @@ bool isUsableScan(const CObservation& o)
 {
 	if (const auto* s3 = dynamic_cast<const CObservation3DRangeScan*>(&o))
 		return (s3->hasRangeImage && s3->rangeImage.cols() > 0 && s3->rangeImage.rows() > 0) ||
-			(s3->hasPoints3D && !s3->points3D_x.empty());
+			   (s3->hasPoints3D && !s3->points3D_x.empty());
 	if (const auto* s2 = dynamic_cast<const CObservation2DRangeScan*>(&o)) return s2->getScanSize() > 0;
 	return false;
 }

@@ -112,8 +112,7 @@ void CElevation25DMap::setInsertionOptions(const TInsertionOptions& o)
 }
 
 // ---------------------------------------------------------------------------
-CElevation25DMap::CElevation25DMap(
-	double x_min, double x_max, double y_min, double y_max, double resolution)
+CElevation25DMap::CElevation25DMap(double x_min, double x_max, double y_min, double y_max, double resolution)
 {
 	setSize(x_min, x_max, y_min, y_max, resolution);
 }
@@ -188,9 +187,8 @@ std::string CElevation25DMap::asString() const
 {
 	const auto& g = m_grid.geometry();
 	std::ostringstream s;
-	s << "CElevation25DMap " << g.nx << "x" << g.ny << " cells at " << g.resolution << " m, x["
-	  << g.x_min << "," << g.x_max() << "] y[" << g.y_min << "," << g.y_max() << "], "
-	  << m_grid.observedCount() << " observed cells";
+	s << "CElevation25DMap " << g.nx << "x" << g.ny << " cells at " << g.resolution << " m, x[" << g.x_min << ","
+	  << g.x_max() << "] y[" << g.y_min << "," << g.y_max() << "], " << m_grid.observedCount() << " observed cells";
 	return s.str();
 }
 
@@ -219,8 +217,7 @@ void CElevation25DMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t 
 {
 	switch (version)
 	{
-		case 0:
-		{
+		case 0: {
 			gam::GridGeometry g;
 			int32_t nx, ny;
 			in >> g.x_min >> g.y_min >> g.resolution >> nx >> ny;
@@ -235,7 +232,7 @@ void CElevation25DMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t 
 			o.outliers.min_count = uint32_t(omc);
 			o.idw.radius_cells = idr;
 			o.idw.min_neighbours = idn;
-			setInsertionOptions(o);	 // validates
+			setInsertionOptions(o);  // validates
 			in >> genericMapParams;
 			uint32_t n;
 			in >> n;
@@ -315,8 +312,7 @@ void CElevation25DMap::saveAsPngs(const std::string& prefix) const
 		zmax.setPixel(cx, row, mrpt::img::colormap(mrpt::img::cmJET, (c.z_max - zlo) / zr));
 		span.setPixel(cx, row, mrpt::img::colormap(mrpt::img::cmHOT, c.span() / spanMax));
 		count.setPixel(
-			cx, row,
-			mrpt::img::colormap(mrpt::img::cmHOT, std::log1p(float(c.count)) / std::log1p(float(countMax))));
+			cx, row, mrpt::img::colormap(mrpt::img::cmHOT, std::log1p(float(c.count)) / std::log1p(float(countMax))));
 	}
 	if (!zmax.saveToFile(prefix + "_zmax.png") || !span.saveToFile(prefix + "_span.png") ||
 		!count.saveToFile(prefix + "_count.png"))
@@ -324,16 +320,14 @@ void CElevation25DMap::saveAsPngs(const std::string& prefix) const
 	std::ofstream f(prefix + "_scale.txt");
 	// The file name only: the directory may be temporary (the mapper writes into a
 	// hidden folder first), and outputs must not depend on it.
-	const std::string stem = prefix.substr(prefix.find_last_of('/') == std::string::npos ? 0 : prefix.find_last_of('/') + 1);
+	const std::string stem =
+		prefix.substr(prefix.find_last_of('/') == std::string::npos ? 0 : prefix.find_last_of('/') + 1);
 	f << "# colour scales of " << stem << "_*.png (one pixel per cell, +y up, black = no data)\n"
 	  << "zmax_png: jet colormap, blue = " << zlo << " m, red = " << zhi << " m\n"
 	  << "span_png: hot colormap, black = 0 m, white = " << spanMax << " m\n"
 	  << "count_png: hot colormap of log(1+N_z), white = " << countMax << " samples\n"
-	  << "grid: x_min " << g.x_min << " y_min " << g.y_min << " resolution " << g.resolution
-	  << " nx " << g.nx << " ny " << g.ny << "\n";
+	  << "grid: x_min " << g.x_min << " y_min " << g.y_min << " resolution " << g.resolution << " nx " << g.nx << " ny "
+	  << g.ny << "\n";
 }
 
-void CElevation25DMap::saveMetricMapRepresentationToFile(const std::string& prefix) const
-{
-	saveAsPngs(prefix);
-}
+void CElevation25DMap::saveMetricMapRepresentationToFile(const std::string& prefix) const { saveAsPngs(prefix); }

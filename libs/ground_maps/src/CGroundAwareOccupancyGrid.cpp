@@ -15,8 +15,7 @@
 
 using namespace mrpt::maps;
 
-MAP_DEFINITION_REGISTER(
-	"mrpt::maps::CGroundAwareOccupancyGrid,groundAwareGrid", mrpt::maps::CGroundAwareOccupancyGrid)
+MAP_DEFINITION_REGISTER("mrpt::maps::CGroundAwareOccupancyGrid,groundAwareGrid", mrpt::maps::CGroundAwareOccupancyGrid)
 IMPLEMENTS_SERIALIZABLE(CGroundAwareOccupancyGrid, COccupancyGridMap2D, mrpt::maps)
 
 namespace
@@ -88,8 +87,7 @@ void CGroundAwareOccupancyGrid::TMapDefinition::dumpToTextStream_map_specific(st
 	groundOpts.dumpToTextStream(out);
 }
 
-mrpt::maps::CMetricMap* CGroundAwareOccupancyGrid::internal_CreateFromMapDefinition(
-	const TMetricMapInitializer& _def)
+mrpt::maps::CMetricMap* CGroundAwareOccupancyGrid::internal_CreateFromMapDefinition(const TMetricMapInitializer& _def)
 {
 	const auto& def = dynamic_cast<const CGroundAwareOccupancyGrid::TMapDefinition&>(_def);
 	auto* m = new CGroundAwareOccupancyGrid(def.min_x, def.max_x, def.min_y, def.max_y, def.resolution);
@@ -138,9 +136,8 @@ CGroundAwareOccupancyGrid::CGroundAwareOccupancyGrid(
 std::string CGroundAwareOccupancyGrid::asString() const
 {
 	std::ostringstream s;
-	s << "CGroundAwareOccupancyGrid " << getSizeX() << "x" << getSizeY() << " cells at "
-	  << getResolution() << " m, x[" << getXMin() << "," << getXMax() << "] y[" << getYMin() << ","
-	  << getYMax() << "]";
+	s << "CGroundAwareOccupancyGrid " << getSizeX() << "x" << getSizeY() << " cells at " << getResolution() << " m, x["
+	  << getXMin() << "," << getXMax() << "] y[" << getYMin() << "," << getYMax() << "]";
 	return s.str();
 }
 
@@ -166,10 +163,8 @@ bool CGroundAwareOccupancyGrid::internal_insertObservation(
 {
 	using namespace mrpt::obs;
 	const mrpt::poses::CPose3D pose = robotPose ? *robotPose : mrpt::poses::CPose3D();
-	if (const auto* o2 = dynamic_cast<const CObservation2DRangeScan*>(&obs))
-		return insert2D(*o2, robotPose);
-	if (IS_CLASS(obs, CObservation3DRangeScan) || IS_CLASS(obs, CObservationPointCloud))
-		return insert3D(obs, pose);
+	if (const auto* o2 = dynamic_cast<const CObservation2DRangeScan*>(&obs)) return insert2D(*o2, robotPose);
+	if (IS_CLASS(obs, CObservation3DRangeScan) || IS_CLASS(obs, CObservationPointCloud)) return insert3D(obs, pose);
 	return COccupancyGridMap2D::internal_insertObservation(obs, robotPose);
 }
 
@@ -178,11 +173,10 @@ bool CGroundAwareOccupancyGrid::insert2D(
 {
 	const auto scan = gam::maps::safeScanFor(*this, rawScan, robotPose ? *robotPose : mrpt::poses::CPose3D());
 	const bool sparse = int(scan.getScanSize()) < 64 && m_options.sparse_scan_upsampling > 1;
-	const auto up = sparse ? upsampleSparseScan(scan, m_options.sparse_scan_upsampling)
-						   : mrpt::obs::CObservation2DRangeScan();
+	const auto up =
+		sparse ? upsampleSparseScan(scan, m_options.sparse_scan_upsampling) : mrpt::obs::CObservation2DRangeScan();
 	const auto& use = sparse ? up : scan;
-	if (!m_options.scan_keeps_3d_obstacles)
-		return COccupancyGridMap2D::internal_insertObservation(use, robotPose);
+	if (!m_options.scan_keeps_3d_obstacles) return COccupancyGridMap2D::internal_insertObservation(use, robotPose);
 
 	// A planar beam sees only its own height: passing over a hole, a cable or
 	// a 5 cm box says nothing about the floor. So the beam model adds its hits
@@ -200,7 +194,7 @@ bool CGroundAwareOccupancyGrid::insert2D(
 		for (int cx = 0; cx < sx0; cx++)
 		{
 			const cellType old = before[size_t(cy) * size_t(sx0) + size_t(cx)];
-			if (old > 0) continue;	// free before: any update is fine
+			if (old > 0) continue;  // free before: any update is fine
 			const int nx = cx + ox, ny = cy + oy;
 			if (nx < 0 || ny < 0 || nx >= sx || ny >= sy) continue;
 			cellType& now = m_map[size_t(ny) * size_t(sx) + size_t(nx)];
@@ -264,8 +258,8 @@ void CGroundAwareOccupancyGrid::applyEvidence()
 	}
 	if (bx0 < getXMin() || bx1 > getXMax() || by0 < getYMin() || by1 > getYMax())
 		resizeGrid(
-			std::min(bx0, getXMin()), std::max(bx1, getXMax()), std::min(by0, getYMin()),
-			std::max(by1, getYMax()), 0.5f, true);
+			std::min(bx0, getXMin()), std::max(bx1, getXMax()), std::min(by0, getYMin()), std::max(by1, getYMax()),
+			0.5f, true);
 
 	// Log-odds fusion: each cell gets one update per frame. MRPT cells hold
 	// the log-odds of being FREE, so occupied evidence lowers them.
@@ -300,8 +294,7 @@ void CGroundAwareOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in,
 {
 	switch (version)
 	{
-		case 0:
-		{
+		case 0: {
 			uint8_t baseVer;
 			in >> baseVer;
 			COccupancyGridMap2D::serializeFrom(in, baseVer);

@@ -22,8 +22,7 @@ uint8_t pgmValue(COccupancyGridMap2D::cellType cell)
 }
 
 void writeRosMap(
-	const COccupancyGridMap2D& g, const std::string& yamlPath, const std::string& pgmPath,
-	const std::string& imageName)
+	const COccupancyGridMap2D& g, const std::string& yamlPath, const std::string& pgmPath, const std::string& imageName)
 {
 	const int W = int(g.getSizeX()), H = int(g.getSizeY());
 	{

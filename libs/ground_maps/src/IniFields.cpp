@@ -39,8 +39,7 @@ double parseNumber(const std::string& raw, const ParamInfo& info, const std::str
 
 void GridExtent::validate() const
 {
-	if (!(min_x < max_x) || !(min_y < max_y))
-		throw std::invalid_argument("needs min_x < max_x and min_y < max_y");
+	if (!(min_x < max_x) || !(min_y < max_y)) throw std::invalid_argument("needs min_x < max_x and min_y < max_y");
 	gam::maps::checkGridSize("the grid", min_x, max_x, min_y, max_y, resolution);
 }
 

@@ -17,7 +17,7 @@ struct Registry
 };
 Registry& registry()
 {
-	static Registry r;	// constructed on first use: safe from other libraries' initializers
+	static Registry r;  // constructed on first use: safe from other libraries' initializers
 	return r;
 }
 

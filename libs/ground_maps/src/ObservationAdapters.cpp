@@ -39,8 +39,8 @@ namespace
 {
 bool finitePose(const mrpt::poses::CPose3D& p)
 {
-	return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()) &&
-		   std::isfinite(p.yaw()) && std::isfinite(p.pitch()) && std::isfinite(p.roll());
+	return std::isfinite(p.x()) && std::isfinite(p.y()) && std::isfinite(p.z()) && std::isfinite(p.yaw()) &&
+		   std::isfinite(p.pitch()) && std::isfinite(p.roll());
 }
 }  // namespace
 
@@ -71,7 +71,7 @@ bool toSensorFrame(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3
 	out = SensorFrame{};
 	if (const auto* o3 = dynamic_cast<const CObservation3DRangeScan*>(&obs))
 	{
-		o3->load();	 // externally stored images
+		o3->load();  // externally stored images
 		if (!finitePose(o3->sensorPose))
 			throw std::invalid_argument("CObservation3DRangeScan.sensorPose is not finite");
 		if (o3->maxRange > 0) out.max_range = o3->maxRange;
@@ -104,8 +104,7 @@ bool toSensorFrame(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3
 	{
 		pc->load();
 		if (!pc->pointcloud) return true;  // nothing to bin
-		if (!finitePose(pc->sensorPose))
-			throw std::invalid_argument("CObservationPointCloud.sensorPose is not finite");
+		if (!finitePose(pc->sensorPose)) throw std::invalid_argument("CObservationPointCloud.sensorPose is not finite");
 		placeSensor(robotPose + pc->sensorPose, out);
 		const auto& P = *pc->pointcloud;
 		out.x = P.getPointsBufferRef_x().data();
@@ -157,22 +156,19 @@ bool binObservation(
 
 void checkRangeScan(const mrpt::obs::CObservation3DRangeScan& o)
 {
-	if (!finitePose(o.sensorPose))
-		throw std::invalid_argument("CObservation3DRangeScan.sensorPose is not finite");
+	if (!finitePose(o.sensorPose)) throw std::invalid_argument("CObservation3DRangeScan.sensorPose is not finite");
 	if (o.hasRangeImage && o.rangeImage.rows() > 0 && o.rangeImage.cols() > 0)
 	{
 		const PinholeIntrinsics K = intrinsicsOf(o);
 		K.validate();
 		if (int(o.rangeImage.rows()) != K.height || int(o.rangeImage.cols()) != K.width)
 			throw std::invalid_argument(
-				"range image is " + std::to_string(o.rangeImage.cols()) + "x" +
-				std::to_string(o.rangeImage.rows()) + " but the camera parameters say " +
-				std::to_string(K.width) + "x" + std::to_string(K.height));
+				"range image is " + std::to_string(o.rangeImage.cols()) + "x" + std::to_string(o.rangeImage.rows()) +
+				" but the camera parameters say " + std::to_string(K.width) + "x" + std::to_string(K.height));
 		if (!(o.rangeUnits > 0) || !std::isfinite(o.rangeUnits))
 			throw std::invalid_argument("rangeUnits must be > 0 (got " + std::to_string(o.rangeUnits) + ")");
 	}
-	if (o.hasPoints3D &&
-		(o.points3D_y.size() != o.points3D_x.size() || o.points3D_z.size() != o.points3D_x.size()))
+	if (o.hasPoints3D && (o.points3D_y.size() != o.points3D_x.size() || o.points3D_z.size() != o.points3D_x.size()))
 		throw std::invalid_argument("CObservation3DRangeScan.points3D_x/y/z sizes differ");
 }
 
@@ -185,8 +181,8 @@ void checkGridSize(const std::string& what, double x0, double x1, double y0, dou
 	if (nx * ny > kMaxGridCells)
 	{
 		std::ostringstream s;
-		s << what << ": a grid of " << nx << " x " << ny << " cells (x " << x0 << " to " << x1 << ", y " << y0
-		  << " to " << y1 << " at " << resolution << " m) is too large (limit " << kMaxGridCells
+		s << what << ": a grid of " << nx << " x " << ny << " cells (x " << x0 << " to " << x1 << ", y " << y0 << " to "
+		  << y1 << " at " << resolution << " m) is too large (limit " << kMaxGridCells
 		  << " cells); shrink the area or use a coarser resolution";
 		throw std::invalid_argument(s.str());
 	}
@@ -196,12 +192,12 @@ void checkScanGrowth(
 	const mrpt::maps::COccupancyGridMap2D& g, const mrpt::poses::CPose3D& sensorInMap, double farthestRange)
 {
 	if (!finitePose(sensorInMap)) throw std::invalid_argument("robot or sensor pose is not finite");
-	const double reach =
-		std::max({0.0, double(g.insertionOptions.maxDistanceInsertion), farthestRange}) + 1.0;
+	const double reach = std::max({0.0, double(g.insertionOptions.maxDistanceInsertion), farthestRange}) + 1.0;
 	const double x = sensorInMap.x(), y = sensorInMap.y();
 	checkGridSize(
-		"growing the grid to the scan", std::min<double>(g.getXMin(), x - reach), std::max<double>(g.getXMax(), x + reach),
-		std::min<double>(g.getYMin(), y - reach), std::max<double>(g.getYMax(), y + reach), g.getResolution());
+		"growing the grid to the scan", std::min<double>(g.getXMin(), x - reach),
+		std::max<double>(g.getXMax(), x + reach), std::min<double>(g.getYMin(), y - reach),
+		std::max<double>(g.getYMax(), y + reach), g.getResolution());
 }
 
 mrpt::obs::CObservation2DRangeScan safeScanFor(

@@ -5,18 +5,6 @@
 
 namespace gam::sim
 {
-const char* labelName(Label l)
-{
-	switch (l)
-	{
-		case Label::Free: return "free";
-		case Label::Obstacle: return "obstacle";
-		case Label::Drop: return "drop";
-		case Label::Unobserved: return "unobserved";
-	}
-	return "?";
-}
-
 int GridSpec::nx() const { return std::max(1, int(std::lround((max_x - min_x) / resolution))); }
 int GridSpec::ny() const { return std::max(1, int(std::lround((max_y - min_y) / resolution))); }
 
@@ -41,8 +29,7 @@ Label GroundTruthGrid::probe(const Scene& scene, const GridSpec& s, double x, do
 	std::vector<Ext> ext;
 	for (const auto& sol : scene.solids)
 	{
-		if (x < sol.bbox.min().x() || x > sol.bbox.max().x() || y < sol.bbox.min().y() ||
-			y > sol.bbox.max().y())
+		if (x < sol.bbox.min().x() || x > sol.bbox.max().x() || y < sol.bbox.min().y() || y > sol.bbox.max().y())
 			continue;
 		double lo, hi;
 		if (!sol.verticalExtent(x, y, lo, hi)) continue;
@@ -107,8 +94,7 @@ void GroundTruthGrid::build(Scene& scene, const GridSpec& s)
 					over = over || sol.bbox.min().z() > s.overhang_clearance;
 					top = std::max(top, sol.bbox.max().z());
 				}
-			o.category = over ? Category::Overhang
-							  : (top < s.small_max_height ? Category::Small : Category::Large);
+			o.category = over ? Category::Overhang : (top < s.small_max_height ? Category::Small : Category::Large);
 		}
 	}
 	const int nx = s.nx(), ny = s.ny();

@@ -55,8 +55,7 @@ std::vector<Pose2> samplePath(const PathSpec& spec)
 	return out;
 }
 
-std::vector<Pose2> simulateOdometry(
-	const std::vector<Pose2>& truth, const OdometryNoise& n, std::mt19937& rng)
+std::vector<Pose2> simulateOdometry(const std::vector<Pose2>& truth, const OdometryNoise& n, std::mt19937& rng)
 {
 	std::vector<Pose2> odo;
 	if (truth.empty()) return odo;

@@ -34,8 +34,7 @@ bool categoryFromName(const std::string& s, Category& c)
 Pose3 Pose3::fromXYZYPR(double x, double y, double z, double yaw, double pitch, double roll)
 {
 	Pose3 p;
-	p.R = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-		   Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+	p.R = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
 		   Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
 			  .toRotationMatrix();
 	p.t = Eigen::Vector3d(x, y, z);
@@ -120,7 +119,7 @@ bool ConvexSolid::intersect(
 	for (size_t i = 0; i < n.size(); i++)
 	{
 		const double den = n[i].dot(dir);
-		const double dist = d[i] - n[i].dot(o);	 // >= 0 if o is inside this half-space
+		const double dist = d[i] - n[i].dot(o);  // >= 0 if o is inside this half-space
 		if (std::abs(den) < 1e-15)
 		{
 			if (dist < 0) return false;
@@ -139,7 +138,7 @@ bool ConvexSolid::intersect(
 			tout = ti;
 		if (tin > tout) return false;
 	}
-	if (inPlane < 0) return false;	// started inside (or tangent)
+	if (inPlane < 0) return false;  // started inside (or tangent)
 	t = tin;
 	normal = n[size_t(inPlane)];
 	return true;
@@ -180,8 +179,7 @@ bool Hole::containsXY(double x, double y) const
 	return std::abs(lx) < hx && std::abs(ly) < hy;
 }
 
-double Hole::exitT(
-	const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double tmin, Eigen::Vector3d& normal) const
+double Hole::exitT(const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double tmin, Eigen::Vector3d& normal) const
 {
 	const double inf = std::numeric_limits<double>::infinity();
 	double best = inf;
@@ -256,8 +254,7 @@ double Hole::exitT(
 }
 
 // ---------------------------------------------------------------------- Scene
-bool Scene::castGround(
-	const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double tmin, double tmax, RayHit& h) const
+bool Scene::castGround(const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double tmin, double tmax, RayHit& h) const
 {
 	if (!has_floor) return false;
 	const double eps = 1e-9 / std::max(1e-12, dir.norm());

@@ -21,15 +21,11 @@ class Args
    public:
 	Args(const std::string& kw, const std::string& where) : m_kw(kw), m_where(where) {}
 	const std::string& keyword() const { return m_kw; }
-	[[noreturn]] void fail(const std::string& msg) const
-	{
-		throw SceneError(m_where + ": " + m_kw + ": " + msg);
-	}
+	[[noreturn]] void fail(const std::string& msg) const { throw SceneError(m_where + ": " + m_kw + ": " + msg); }
 	void add(const std::string& tok)
 	{
 		const auto eq = tok.find('=');
-		if (eq == std::string::npos || eq == 0 || eq + 1 == tok.size())
-			fail("expected key=value, got '" + tok + "'");
+		if (eq == std::string::npos || eq == 0 || eq + 1 == tok.size()) fail("expected key=value, got '" + tok + "'");
 		const std::string k = tok.substr(0, eq);
 		if (m_kv.count(k)) fail("duplicate key '" + k + "'");
 		m_kv[k] = tok.substr(eq + 1);
@@ -115,10 +111,7 @@ Pose3 poseOf(const std::vector<double>& v)
 }
 
 /** Pose of a primitive's local frame: origin on the floor at (x,y,z), yawed. */
-Pose3 planar(double x, double y, double z, double yawDeg)
-{
-	return Pose3::fromXYZYPR(x, y, z, yawDeg * kDeg, 0, 0);
-}
+Pose3 planar(double x, double y, double z, double yawDeg) { return Pose3::fromXYZYPR(x, y, z, yawDeg * kDeg, 0, 0); }
 
 /** Axis-aligned box in a local frame given by its min/max corners. */
 ConvexSolid localBox(const Pose3& f, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int id)
@@ -150,8 +143,7 @@ ObjectInfo& beginObject(SceneBuilder& b, Args& a, const std::string& type)
 	oi.name = a.str("name", type + "_" + std::to_string(id));
 	if (a.has("category"))
 	{
-		if (!categoryFromName(a.str("category"), oi.category))
-			a.fail("unknown category '" + a.str("category") + "'");
+		if (!categoryFromName(a.str("category"), oi.category)) a.fail("unknown category '" + a.str("category") + "'");
 		oi.category_given = true;
 	}
 	b.sf.scene.objects.push_back(oi);
@@ -311,8 +303,8 @@ void parseStairsDown(SceneBuilder& b, Args& a)
 	// tread k (1..steps-1) at z = -k*rise over x in [(k-1)run, k run]
 	for (int k = 1; k < s.steps; k++)
 		b.sf.scene.solids.push_back(localBox(
-			s.f, Eigen::Vector3d((k - 1) * s.run, -0.5 * s.w, -D),
-			Eigen::Vector3d(k * s.run, 0.5 * s.w, -k * s.rise), s.id));
+			s.f, Eigen::Vector3d((k - 1) * s.run, -0.5 * s.w, -D), Eigen::Vector3d(k * s.run, 0.5 * s.w, -k * s.rise),
+			s.id));
 }
 
 void parseStairsUp(SceneBuilder& b, Args& a)
@@ -359,8 +351,8 @@ void parseRamp(SceneBuilder& b, Args& a)
 	addSlope(f);
 	if (plateau > 0)
 		sc.solids.push_back(localBox(
-			f, Eigen::Vector3d(L, -0.5 * w, sides == "solid" ? 0.0 : H - th),
-			Eigen::Vector3d(L + plateau, 0.5 * w, H), oi.id));
+			f, Eigen::Vector3d(L, -0.5 * w, sides == "solid" ? 0.0 : H - th), Eigen::Vector3d(L + plateau, 0.5 * w, H),
+			oi.id));
 	if (back) addSlope(f * planar(2 * L + plateau, 0, 0, 180.0));
 }
 
@@ -372,14 +364,14 @@ void parseTable(SceneBuilder& b, Args& a)
 	const double sx = a.pos("sx", 0, true), sy = a.pos("sy", 0, true);
 	const double H = a.pos("height", 0.75), top = a.pos("top", 0.04), leg = a.pos("leg", 0.05);
 	if (top >= H || 2 * leg >= std::min(sx, sy)) a.fail("inconsistent table sizes");
-	sc.solids.push_back(localBox(
-		f, Eigen::Vector3d(-0.5 * sx, -0.5 * sy, H - top), Eigen::Vector3d(0.5 * sx, 0.5 * sy, H), oi.id));
+	sc.solids.push_back(
+		localBox(f, Eigen::Vector3d(-0.5 * sx, -0.5 * sy, H - top), Eigen::Vector3d(0.5 * sx, 0.5 * sy, H), oi.id));
 	for (int i = 0; i < 4; i++)
 	{
 		const double lx = (i & 1) ? 0.5 * sx - leg : -0.5 * sx;
 		const double ly = (i & 2) ? 0.5 * sy - leg : -0.5 * sy;
-		sc.solids.push_back(localBox(
-			f, Eigen::Vector3d(lx, ly, 0), Eigen::Vector3d(lx + leg, ly + leg, H - top), oi.id));
+		sc.solids.push_back(
+			localBox(f, Eigen::Vector3d(lx, ly, 0), Eigen::Vector3d(lx + leg, ly + leg, H - top), oi.id));
 	}
 }
 
@@ -397,8 +389,8 @@ void parseShelf(SceneBuilder& b, Args& a)
 	for (int s = -1; s <= 1; s += 2)
 	{
 		const double x0 = s < 0 ? -0.5 * sx : 0.5 * sx - side;
-		sc.solids.push_back(localBox(
-			f, Eigen::Vector3d(x0, -0.5 * sy, 0), Eigen::Vector3d(x0 + side, 0.5 * sy, sz), oi.id));
+		sc.solids.push_back(
+			localBox(f, Eigen::Vector3d(x0, -0.5 * sy, 0), Eigen::Vector3d(x0 + side, 0.5 * sy, sz), oi.id));
 	}
 	const int n = int(nb);
 	for (int k = 0; k < n; k++)

@@ -54,7 +54,7 @@ DepthFrame KinectModel::render(const Scene& scene, const Pose3& sensor, std::mt1
 		for (int c = 0; c < p.width; c++)
 		{
 			const size_t i = f.idx(r, c);
-			const Eigen::Vector3d dir = sensor.R * pixelRay(r, c);	// t == depth along +X
+			const Eigen::Vector3d dir = sensor.R * pixelRay(r, c);  // t == depth along +X
 			const RayHit h = scene.cast(sensor.t, dir, 1e-6, kFar);
 			if (h.hit)
 			{

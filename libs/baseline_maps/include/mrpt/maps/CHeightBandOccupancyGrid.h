@@ -1,11 +1,11 @@
 // Ground-aware mapping for MRPT
 #pragma once
 
-#include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/config/CLoadableOptions.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
 
-#include "gam/core/Parameters.h"
 #include <mrpt/obs/CObservation2DRangeScan.h>
+#include "gam/core/Parameters.h"
 
 namespace mrpt::maps
 {
@@ -36,21 +36,23 @@ class CHeightBandOccupancyGrid : public COccupancyGridMap2D
 
    public:
 	CHeightBandOccupancyGrid(
-		float min_x = -10.0f, float max_x = 10.0f, float min_y = -10.0f, float max_y = 10.0f,
-		float resolution = 0.05f);
+		float min_x = -10.0f, float max_x = 10.0f, float min_y = -10.0f, float max_y = 10.0f, float resolution = 0.05f);
 
 	struct THeightBandOptions : public mrpt::config::CLoadableOptions
 	{
-		double z_min = 0.2;	 ///< lowest robot-frame z kept [m]
-		double z_max = 1.5;	 ///< highest robot-frame z kept [m]
+		double z_min = 0.2;               ///< lowest robot-frame z kept [m]
+		double z_max = 1.5;               ///< highest robot-frame z kept [m]
 		double oversampling_ratio = 1.2;  ///< virtual rays = image width * this
 
 		template <class Self, class Visit>
 		static void forEachParam(Self& o, Visit&& visit)
 		{
 			visit(gam::ParamInfo{"z_min", -100, 100, "lowest robot-frame z turned into the virtual scan [m]"}, o.z_min);
-			visit(gam::ParamInfo{"z_max", -100, 100, "highest robot-frame z turned into the virtual scan [m]"}, o.z_max);
-			visit(gam::ParamInfo{"oversampling_ratio", 0.1, 10, "virtual rays per depth-image column"}, o.oversampling_ratio);
+			visit(
+				gam::ParamInfo{"z_max", -100, 100, "highest robot-frame z turned into the virtual scan [m]"}, o.z_max);
+			visit(
+				gam::ParamInfo{"oversampling_ratio", 0.1, 10, "virtual rays per depth-image column"},
+				o.oversampling_ratio);
 		}
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
@@ -59,10 +61,7 @@ class CHeightBandOccupancyGrid : public COccupancyGridMap2D
 	} bandOptions;
 
 	/** The virtual scan made from the last 3D observation (robot frame). */
-	const mrpt::obs::CObservation2DRangeScan* lastVirtualScan() const
-	{
-		return m_hasLastScan ? &m_lastScan : nullptr;
-	}
+	const mrpt::obs::CObservation2DRangeScan* lastVirtualScan() const { return m_hasLastScan ? &m_lastScan : nullptr; }
 
 	std::string asString() const override;
 

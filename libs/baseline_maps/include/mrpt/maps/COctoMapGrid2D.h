@@ -1,9 +1,9 @@
 // Ground-aware mapping for MRPT
 #pragma once
 
+#include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/maps/COctoMap.h>
-#include <mrpt/config/CLoadableOptions.h>
 
 #include "gam/core/Parameters.h"
 
@@ -41,21 +41,20 @@ class COctoMapGrid2D : public COccupancyGridMap2D
 
    public:
 	COctoMapGrid2D(
-		float min_x = -10.0f, float max_x = 10.0f, float min_y = -10.0f, float max_y = 10.0f,
-		float resolution = 0.05f);
+		float min_x = -10.0f, float max_x = 10.0f, float min_y = -10.0f, float max_y = 10.0f, float resolution = 0.05f);
 
 	struct TOctoOptions : public mrpt::config::CLoadableOptions
 	{
 		double voxel_size = 0.05;  ///< octomap resolution [m]
-		double z_min = 0.05;  ///< projection band, robot/map frame [m]
-		double z_max = 1.8;	 ///< the robot height [m]
-		int decimation = 4;	 ///< every n-th range-image pixel (rounded down to a divisor of W and H)
-		double max_range = 5.0;	 ///< rays are truncated here (octomap maxrange) [m]
+		double z_min = 0.05;       ///< projection band, robot/map frame [m]
+		double z_max = 1.8;        ///< the robot height [m]
+		int decimation = 4;        ///< every n-th range-image pixel (rounded down to a divisor of W and H)
+		double max_range = 5.0;    ///< rays are truncated here (octomap maxrange) [m]
 		double prob_hit = 0.7, prob_miss = 0.4;
 		double clamping_min = 0.1192, clamping_max = 0.971;
 		double occupancy_thres = 0.5;
-		int project_every = 1;	///< re-project every n inserted frames; 0 = only on request / when saved
-		bool mark_free = true;	///< free voxels in the band make free cells
+		int project_every = 1;  ///< re-project every n inserted frames; 0 = only on request / when saved
+		bool mark_free = true;  ///< free voxels in the band make free cells
 
 		template <class Self, class Visit>
 		static void forEachParam(Self& o, Visit&& visit)
@@ -71,7 +70,9 @@ class COctoMapGrid2D : public COccupancyGridMap2D
 			visit(ParamInfo{"clamping_min", 0, 1, "octomap lower clamping probability"}, o.clamping_min);
 			visit(ParamInfo{"clamping_max", 0, 1, "octomap upper clamping probability"}, o.clamping_max);
 			visit(ParamInfo{"occupancy_thres", 0, 1, "a voxel is occupied above this probability"}, o.occupancy_thres);
-			visit(ParamInfo{"project_every", 0, 1000000, "re-project every n frames (0 = only when saved)"}, o.project_every);
+			visit(
+				ParamInfo{"project_every", 0, 1000000, "re-project every n frames (0 = only when saved)"},
+				o.project_every);
 			visit(ParamInfo{"mark_free", 0, 1, "free voxels in the band make free cells"}, o.mark_free);
 		}
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;

@@ -24,8 +24,8 @@ struct PinholeIntrinsics
 	double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
 	bool operator==(const PinholeIntrinsics& o) const
 	{
-		return width == o.width && height == o.height && fx == o.fx && fy == o.fy && cx == o.cx &&
-			   cy == o.cy && k1 == o.k1 && k2 == o.k2 && p1 == o.p1 && p2 == o.p2 && k3 == o.k3;
+		return width == o.width && height == o.height && fx == o.fx && fy == o.fy && cx == o.cx && cy == o.cy &&
+			   k1 == o.k1 && k2 == o.k2 && p1 == o.p1 && p2 == o.p2 && k3 == o.k3;
 	}
 	/** Throws std::invalid_argument naming the bad value. */
 	void validate() const;
@@ -47,11 +47,11 @@ struct RangeImageView
 /** What the projector keeps. Heights are in the grid frame. */
 struct ProjectionFilter
 {
-	float min_range = 0.0f;	 ///< metres along the sensor +X (depth) or the ray (range)
+	float min_range = 0.0f;  ///< metres along the sensor +X (depth) or the ray (range)
 	float max_range = 5.0f;
 	float z_min = -std::numeric_limits<float>::infinity();
 	float z_max = std::numeric_limits<float>::infinity();
-	int decimation = 1;	 ///< use every n-th row and column
+	int decimation = 1;  ///< use every n-th row and column
 
 	/** The .ini keys, shared by every map that projects depth frames. */
 	template <class Self, class Visit>
@@ -108,7 +108,7 @@ class DepthProjector
 	PinholeIntrinsics m_lutK;
 	// Ray table, one entry per pixel, as separate arrays so the row loop vectorizes.
 	std::vector<float> m_rayY, m_rayZ;  // y/x and z/x
-	std::vector<float> m_rayInvNorm;	// 1 / |(1, y/x, z/x)|, for range images
+	std::vector<float> m_rayInvNorm;    // 1 / |(1, y/x, z/x)|, for range images
 	// One row of results before compaction (cell or -1, z).
 	std::vector<int32_t> m_rowCell;
 	std::vector<float> m_rowZ;

@@ -45,8 +45,7 @@ struct GridGeometry
 	void validate() const;
 	bool operator==(const GridGeometry& o) const
 	{
-		return x_min == o.x_min && y_min == o.y_min && resolution == o.resolution && nx == o.nx &&
-			   ny == o.ny;
+		return x_min == o.x_min && y_min == o.y_min && resolution == o.resolution && nx == o.nx && ny == o.ny;
 	}
 };
 
@@ -55,9 +54,9 @@ struct ElevationCell
 {
 	float z_min = std::numeric_limits<float>::infinity();
 	float z_max = -std::numeric_limits<float>::infinity();
-	uint32_t count = 0;	 ///< N_z, after outlier removal
-	float z_sum = 0;  ///< sum of z (for the mean)
-	float z_sq_sum = 0;	 ///< sum of z^2 (for the variance)
+	uint32_t count = 0;  ///< N_z, after outlier removal
+	float z_sum = 0;     ///< sum of z (for the mean)
+	float z_sq_sum = 0;  ///< sum of z^2 (for the variance)
 	/** Inverse-distance-weighted height estimate for cells with count == 0
 	 * (NaN when not interpolated). Never counts as an observation. */
 	float z_idw = std::numeric_limits<float>::quiet_NaN();
@@ -170,7 +169,7 @@ struct IdwParams
 {
 	int radius_cells = 0;  ///< 0 disables it
 	float power = 2.0f;
-	int min_neighbours = 3;	 ///< observed cells needed in the window
+	int min_neighbours = 3;  ///< observed cells needed in the window
 
 	/** The .ini keys, shared by every map that keeps a 2.5D grid. */
 	template <class Self, class Visit>
@@ -251,8 +250,8 @@ class ElevationGrid
    private:
 	GridGeometry m_geom;
 	std::vector<ElevationCell> m_cells;
-	std::vector<uint32_t> m_touched;  // cells with count > 0
-	std::vector<uint32_t> m_idwTouched;	 // cells holding an IDW value
+	std::vector<uint32_t> m_touched;     // cells with count > 0
+	std::vector<uint32_t> m_idwTouched;  // cells holding an IDW value
 	// Frame scratch (kept to avoid per-frame allocations):
 	std::vector<FrameCell> m_frame;
 	std::vector<uint32_t> m_frameTouched;

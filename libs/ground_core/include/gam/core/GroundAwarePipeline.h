@@ -64,18 +64,18 @@ struct GridLattice
 /** Milliseconds each stage of the last frame took. */
 struct StageTimes
 {
-	double projection = 0;	///< frame grid placement + binning
-	double outliers = 0;  ///< 3-sigma filter + IDW
-	double ground = 0;	///< RRT-GPD + RANSAC
-	double ism = 0;	 ///< inverse sensor model
+	double projection = 0;  ///< frame grid placement + binning
+	double outliers = 0;    ///< 3-sigma filter + IDW
+	double ground = 0;      ///< RRT-GPD + RANSAC
+	double ism = 0;         ///< inverse sensor model
 };
 
 /** What the last frame gave. */
 struct FrameResult
 {
-	bool valid = false;	 ///< a frame was processed
-	size_t samples = 0;	 ///< samples binned (before the 3-sigma filter)
-	size_t points = 0;	///< samples kept in the 2.5D map
+	bool valid = false;               ///< a frame was processed
+	size_t samples = 0;               ///< samples binned (before the 3-sigma filter)
+	size_t points = 0;                ///< samples kept in the 2.5D map
 	Eigen::Vector3d sensor{0, 0, 0};  ///< sensor position (map frame)
 	GroundDetection detection;
 	IsmStats ism;

@@ -18,12 +18,12 @@ namespace gam
 {
 struct IsmParams
 {
-	double d_pth = 0.03;  ///< plane distance threshold [m]: |d| <= d_pth is ground
-	double K_g = 0.3;  ///< ground gain: a ground voxel says P(occ) = 0.5 - K_g * G(d)
+	double d_pth = 0.03;   ///< plane distance threshold [m]: |d| <= d_pth is ground
+	double K_g = 0.3;      ///< ground gain: a ground voxel says P(occ) = 0.5 - K_g * G(d)
 	double sigma2 = 0.02;  ///< variance of G(d) = exp(-d^2 / (2 sigma2)) [m^2]
-	double K_n = 0.0005;  ///< density gain [m^3 per point]
-	double d_min = 3.0;	 ///< density offset of the sigmoid
-	double K_m = 0.8;  ///< obstacle gain: P(occ) = 0.5 + 0.5 * K_m * P_rho
+	double K_n = 0.0005;   ///< density gain [m^3 per point]
+	double d_min = 3.0;    ///< density offset of the sigmoid
+	double K_m = 0.8;      ///< obstacle gain: P(occ) = 0.5 + 0.5 * K_m * P_rho
 	/** Depth noise of the sensor, sigma(r) = c0 + c2 * r^2 [m] (defaults: the
 	 * Kinect v1 model of Nguyen et al. 2012; a Kinect One is better, so these
 	 * are conservative for it). Seen from the sensor at height h, a floor point
@@ -31,7 +31,7 @@ struct IsmParams
 	 * widens to d_pth + noise_sigmas * that: far floor is not an obstacle. */
 	double depth_noise_c0 = 0.0012;
 	double depth_noise_c2 = 0.0019;
-	double noise_sigmas = 3.0;	///< 0 = the paper's fixed d_pth
+	double noise_sigmas = 3.0;  ///< 0 = the paper's fixed d_pth
 	/** Measure the floor's vertical scatter in each frame instead: the median
 	 * sample std of the floor cells in 0.5 m range bins (bins with at least
 	 * floor_noise_min_cells such cells; the model above fills the others). A
@@ -72,16 +72,32 @@ struct IsmParams
 		visit(ParamInfo{"K_m", 0, 0.999, "obstacle gain"}, p.K_m);
 		visit(ParamInfo{"depth_noise_c0", 0, 1, "sensor depth noise sigma = c0 + c2 r^2: c0 [m]"}, p.depth_noise_c0);
 		visit(ParamInfo{"depth_noise_c2", 0, 1, "c2 [1/m]"}, p.depth_noise_c2);
-		visit(ParamInfo{"noise_sigmas", 0, 10, "ground band = d_pth + noise_sigmas * vertical noise; 0 = fixed d_pth"}, p.noise_sigmas);
-		visit(ParamInfo{"min_obstacle_points", 1, 1000000, "obstacle/drop voxels with fewer samples are ignored (depth spikes)"}, p.min_obstacle_points);
-		visit(ParamInfo{"measure_floor_noise", 0, 1, "band from the floor's scatter measured in each frame (model where too little floor)"}, p.measure_floor_noise);
-		visit(ParamInfo{"floor_noise_min_cells", 1, 1000000, "floor cells a 0.5 m range bin needs to be measured"}, p.floor_noise_min_cells);
+		visit(
+			ParamInfo{"noise_sigmas", 0, 10, "ground band = d_pth + noise_sigmas * vertical noise; 0 = fixed d_pth"},
+			p.noise_sigmas);
+		visit(
+			ParamInfo{
+				"min_obstacle_points", 1, 1000000,
+				"obstacle/drop voxels with fewer samples are ignored (depth spikes)"},
+			p.min_obstacle_points);
+		visit(
+			ParamInfo{
+				"measure_floor_noise", 0, 1,
+				"band from the floor's scatter measured in each frame (model where too little floor)"},
+			p.measure_floor_noise);
+		visit(
+			ParamInfo{"floor_noise_min_cells", 1, 1000000, "floor cells a 0.5 m range bin needs to be measured"},
+			p.floor_noise_min_cells);
 		visit(ParamInfo{"robot_height", 1e-3, 100, "voxels entirely above this do not block [m]"}, p.robot_height);
 		visit(ParamInfo{"drop_rays", 0, 1, "mark cells where rays went below the ground"}, p.drop_rays);
 		visit(ParamInfo{"max_drop_ray_length", 0, 100, "longest drop ray [m]"}, p.max_drop_ray_length);
-		visit(ParamInfo{"drop_ray_min_points", 1, 1000000, "samples a drop voxel needs to cast its ray"}, p.drop_ray_min_points);
+		visit(
+			ParamInfo{"drop_ray_min_points", 1, 1000000, "samples a drop voxel needs to cast its ray"},
+			p.drop_ray_min_points);
 		visit(ParamInfo{"local_planes", 0, 1, "use ramp patches near their nodes"}, p.local_planes);
-		visit(ParamInfo{"plane_support_radius", 0, 100, "reach of a ramp patch around its nodes [m]"}, p.plane_support_radius);
+		visit(
+			ParamInfo{"plane_support_radius", 0, 100, "reach of a ramp patch around its nodes [m]"},
+			p.plane_support_radius);
 	}
 	/** Throws std::invalid_argument naming the parameter out of range. */
 	void validate() const;
@@ -111,16 +127,16 @@ enum class VoxelClass : uint8_t
 {
 	None = 0,
 	Ground,
-	Obstacle,  ///< sticks out above the ground
-	Drop,  ///< entirely below the ground: hole, outlet, downward step
-	Overhead,  ///< above robot_height: ignored
-	OutOfRange	///< beyond max_range: ignored
+	Obstacle,   ///< sticks out above the ground
+	Drop,       ///< entirely below the ground: hole, outlet, downward step
+	Overhead,   ///< above robot_height: ignored
+	OutOfRange  ///< beyond max_range: ignored
 };
 
 struct IsmStats
 {
 	size_t ground = 0, obstacle = 0, drop = 0, overhead = 0, out_of_range = 0;
-	size_t sparse = 0;	///< obstacle/drop voxels below min_obstacle_points: ignored
+	size_t sparse = 0;  ///< obstacle/drop voxels below min_obstacle_points: ignored
 	size_t drop_ray_cells = 0;
 	bool applied = false;  ///< false when there was no ground plane
 };
@@ -155,8 +171,7 @@ class InverseSensorModel
 	const std::vector<VoxelClass>& classes() const { return m_class; }
 
 	/** Classification of one voxel against one plane (exposed for tests). */
-	VoxelClass classify(
-		const ElevationCell& c, double x, double y, const Plane& pl, double band, double& dMean) const;
+	VoxelClass classify(const ElevationCell& c, double x, double y, const Plane& pl, double band, double& dMean) const;
 	/** Half-width of the ground band for a voxel at (x, y, z) seen from `sensor`
 	 * (h: sensor height over the plane): d_pth + noise_sigmas * the floor's
 	 * vertical noise at that range, measured in the last compute() or modelled. */
@@ -169,7 +184,7 @@ class InverseSensorModel
 	void measureFloorNoise(const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor);
 
 	static constexpr double kNoiseBin = 0.5;  ///< range bin of the floor noise [m]
-	std::vector<float> m_floorNoise;  ///< per bin: measured std [m], < 0 = not measured
+	std::vector<float> m_floorNoise;          ///< per bin: measured std [m], < 0 = not measured
 	// Floor samples of all bins in one buffer (bounded by the cell count, so
 	// never reallocated per frame): (bin, std) pairs, then grouped by bin.
 	std::vector<uint32_t> m_noiseBin;

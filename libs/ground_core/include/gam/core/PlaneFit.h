@@ -34,8 +34,7 @@ struct Plane
  * stores heights, so vertical residuals are the natural error). Returns
  * std::nullopt for fewer than 3 samples or a degenerate (collinear) layout.
  * `rms` gets the RMS vertical residual. */
-std::optional<Plane> fitHeightPlaneLeastSquares(
-	const std::vector<Eigen::Vector3d>& pts, double* rms = nullptr);
+std::optional<Plane> fitHeightPlaneLeastSquares(const std::vector<Eigen::Vector3d>& pts, double* rms = nullptr);
 
 /** Total least squares (smallest eigenvector of the covariance): for general
  * 3D points, used to refine RANSAC inliers. */
@@ -44,7 +43,7 @@ std::optional<Plane> fitPlaneTotalLeastSquares(const std::vector<Eigen::Vector3d
 struct RansacParams
 {
 	int iterations = 200;
-	double inlier_distance = 0.05;	///< metres
+	double inlier_distance = 0.05;  ///< metres
 	size_t min_inliers = 3;
 	/** Reject candidate planes tilted more than this (sin of the angle); 1 = any. */
 	double max_horizontal_normal = 1.0;
@@ -66,7 +65,7 @@ std::optional<RansacResult> fitPlaneRansac(
  * false where the other overload returns std::nullopt (`out` is then
  * unspecified). Same result and same use of `rng` as the other overload. */
 bool fitPlaneRansac(
-	const std::vector<Eigen::Vector3d>& pts, const RansacParams& p, std::mt19937& rng,
-	RansacResult& out, std::vector<Eigen::Vector3d>& inlierScratch);
+	const std::vector<Eigen::Vector3d>& pts, const RansacParams& p, std::mt19937& rng, RansacResult& out,
+	std::vector<Eigen::Vector3d>& inlierScratch);
 
 }  // namespace gam

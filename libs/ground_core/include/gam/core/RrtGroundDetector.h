@@ -24,8 +24,8 @@ struct RrtGpdParams
 	/** E_th [m]: a new node's height may differ from its parent's local plane,
 	 * extrapolated to the new position, by at most this. */
 	double elevation_threshold = 0.05;
-	int neighbourhood_x = 3;  ///< s_x [cells], odd
-	int neighbourhood_y = 3;  ///< s_y [cells], odd
+	int neighbourhood_x = 3;          ///< s_x [cells], odd
+	int neighbourhood_y = 3;          ///< s_y [cells], odd
 	double expansion_distance = 0.4;  ///< d_n [m]
 
 	/** Cells whose height spread (std) exceeds this are not surfaces (walls,
@@ -49,7 +49,7 @@ struct RrtGpdParams
 	size_t min_nodes = 8;
 	/** RANSAC over the node centres. */
 	int ransac_iterations = 100;
-	double ransac_inlier_distance = 0.025;	///< [m]
+	double ransac_inlier_distance = 0.025;  ///< [m]
 	/** Extra planes (ramps) need this many supporting nodes; 0 disables them. */
 	size_t min_nodes_per_extra_plane = 3;
 	int max_planes = 3;
@@ -60,7 +60,9 @@ struct RrtGpdParams
 	static void forEachParam(Self& p, Visit&& visit)
 	{
 		visit(ParamInfo{"K", 1, 1000000, "RRT-GPD iterations"}, p.iterations);
-		visit(ParamInfo{"N_th", 1e-6, 1, "max horizontal part of a node's unit normal (sin of tilt)"}, p.normal_threshold);
+		visit(
+			ParamInfo{"N_th", 1e-6, 1, "max horizontal part of a node's unit normal (sin of tilt)"},
+			p.normal_threshold);
 		visit(ParamInfo{"E_th", 1e-6, 10, "max height step from the parent's local plane [m]"}, p.elevation_threshold);
 		visit(ParamInfo{"s_x", 3, 31, "local fit neighbourhood along x [cells, odd]"}, p.neighbourhood_x);
 		visit(ParamInfo{"s_y", 3, 31, "local fit neighbourhood along y [cells, odd]"}, p.neighbourhood_y);
@@ -68,14 +70,18 @@ struct RrtGpdParams
 		visit(ParamInfo{"max_cell_std", 1e-6, 10, "cells rougher than this are not surfaces [m]"}, p.max_cell_std);
 		visit(ParamInfo{"max_fit_rms", 1e-6, 10, "local fits with a larger RMS are not planar [m]"}, p.max_fit_rms);
 		visit(ParamInfo{"min_valid_cells", 3, 961, "cells with a height a local fit needs"}, p.min_valid_cells);
-		visit(ParamInfo{"seed_search_radius", 1e-3, 1000, "seed within this distance of the robot [m]"}, p.seed_search_radius);
+		visit(
+			ParamInfo{"seed_search_radius", 1e-3, 1000, "seed within this distance of the robot [m]"},
+			p.seed_search_radius);
 		visit(ParamInfo{"seed_height_tolerance", 1e-3, 100, "seed height vs robot floor [m]"}, p.seed_height_tolerance);
 		visit(ParamInfo{"seed_attempts", 1, 100, "seeds tried when a tree stays too small"}, p.seed_attempts);
 		visit(ParamInfo{"window_margin", 1e-3, 1000, "sampling window margin around the nodes [m]"}, p.window_margin);
 		visit(ParamInfo{"min_nodes", 3, 1000000, "fewer tree nodes = no ground"}, p.min_nodes);
 		visit(ParamInfo{"ransac_iterations", 1, 1000000, "RANSAC iterations on the nodes"}, p.ransac_iterations);
 		visit(ParamInfo{"ransac_inlier_distance", 1e-6, 10, "RANSAC inlier distance [m]"}, p.ransac_inlier_distance);
-		visit(ParamInfo{"min_nodes_per_extra_plane", 0, 1000000, "nodes an extra ground patch (ramp) needs; 0 = none"}, p.min_nodes_per_extra_plane);
+		visit(
+			ParamInfo{"min_nodes_per_extra_plane", 0, 1000000, "nodes an extra ground patch (ramp) needs; 0 = none"},
+			p.min_nodes_per_extra_plane);
 		visit(ParamInfo{"max_planes", 1, 8, "ground plane + extra patches"}, p.max_planes);
 		visit(ParamInfo{"random_seed", 0, 2147483647, "RNG seed (same seed, same result)"}, p.random_seed);
 	}
@@ -85,10 +91,10 @@ struct RrtGpdParams
 
 struct GroundNode
 {
-	float x = 0, y = 0, z = 0;	///< centre (cell centre, surface height)
-	Plane local;  ///< least-squares plane of its s_x * s_y neighbourhood
+	float x = 0, y = 0, z = 0;  ///< centre (cell centre, surface height)
+	Plane local;                ///< least-squares plane of its s_x * s_y neighbourhood
 	int parent = -1;
-	int plane_id = -1;	///< index into GroundDetection::planes, -1 = none
+	int plane_id = -1;  ///< index into GroundDetection::planes, -1 = none
 };
 
 struct GroundDetection
@@ -96,16 +102,16 @@ struct GroundDetection
 	enum class Status
 	{
 		Ok,
-		EmptyGrid,	///< no observed cell at all
+		EmptyGrid,    ///< no observed cell at all
 		NoValidSeed,  ///< nothing planar near the robot at floor height
 		TooFewNodes,  ///< the tree did not grow: no floor of useful size
-		NoConsensus	 ///< RANSAC found no plane among the nodes
+		NoConsensus   ///< RANSAC found no plane among the nodes
 	};
 	Status status = Status::EmptyGrid;
 	/** planes[0] is the ground plane; later ones are smaller ground patches
 	 * (ramps) supported by at least min_nodes_per_extra_plane nodes. */
 	std::vector<Plane> planes;
-	std::vector<size_t> plane_support;	///< nodes per plane
+	std::vector<size_t> plane_support;  ///< nodes per plane
 	std::vector<GroundNode> nodes;
 	int iterations = 0;
 
@@ -129,7 +135,7 @@ struct GroundDetection
 struct GroundSeedHint
 {
 	double x = 0, y = 0;  ///< robot position in the grid frame
-	double floor_z = 0;	 ///< expected floor height in the grid frame
+	double floor_z = 0;   ///< expected floor height in the grid frame
 };
 
 class RrtGroundDetector

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "gam/common/GroundTruthLabels.h"
 
 namespace gam::eval
 {
@@ -41,14 +42,8 @@ struct RosMap
  * pgm (maxval 255; the image path is relative to the yaml's folder). Throws Error. */
 RosMap loadRosMap(const std::string& yamlPath);
 
-enum class Label
-{
-	Free,
-	Obstacle,
-	Drop,
-	Unobserved
-};
-const char* labelName(Label l);
+using Label = gam::GroundTruthLabel;
+using gam::labelName;
 
 struct GtObject
 {

@@ -30,8 +30,8 @@ struct MapperOptions
 {
 	std::string rawlogPath;
 	std::string outDir;
-	std::string configText;	 ///< the .ini contents
-	std::string configName = "config";	///< for messages
+	std::string configText;             ///< the .ini contents
+	std::string configName = "config";  ///< for messages
 	std::string section = "map";
 	bool localMap = false;
 	int localCells = 600;
@@ -47,9 +47,9 @@ struct MapSpec
 {
 	std::string iniName;  ///< the name as spelled in `<iniName>_count`
 	unsigned index = 0;
-	std::string prefix;	 ///< `<section>_<iniName>_NN`
-	std::string className;	///< RTTI name
-	std::string label;	///< output file name stem
+	std::string prefix;     ///< `<section>_<iniName>_NN`
+	std::string className;  ///< RTTI name
+	std::string label;      ///< output file name stem
 };
 
 /** Parses and validates the map definitions in `section` (the same order and
@@ -66,8 +66,8 @@ void loadMapDefinitions(
 struct MapTiming
 {
 	std::string label, className;
-	std::vector<double> totalMs;  ///< per frame (all frames)
-	std::vector<double> ms3D, ms2D;	 ///< the same, split by frame kind
+	std::vector<double> totalMs;     ///< per frame (all frames)
+	std::vector<double> ms3D, ms2D;  ///< the same, split by frame kind
 	/** Median / 95th percentile over the 3D frames (over all frames if there are none). */
 	double median() const;
 	double p95() const;
@@ -78,7 +78,7 @@ struct RunSummary
 	size_t frames = 0, frames3D = 0, frames2D = 0, framesWithoutOdometry = 0;
 	double seconds = 0;
 	std::vector<MapTiming> maps;
-	std::vector<std::string> files;	 ///< written, relative to outDir
+	std::vector<std::string> files;  ///< written, relative to outDir
 	std::string text() const;
 };
 

@@ -17,9 +17,9 @@ namespace gam::mapper
 {
 struct Frame
 {
-	size_t index = 0;  ///< 0-based frame number
-	size_t entry = 0;  ///< rawlog entry (object) it came from
-	mrpt::poses::CPose3D robotPose;	 ///< from odometry; identity if none so far
+	size_t index = 0;                ///< 0-based frame number
+	size_t entry = 0;                ///< rawlog entry (object) it came from
+	mrpt::poses::CPose3D robotPose;  ///< from odometry; identity if none so far
 	bool hasOdometry = false;
 	mrpt::obs::CObservation::Ptr obs;  ///< a 3D or 2D range scan (loaded)
 };

@@ -20,8 +20,8 @@ uint8_t pgmValue(mrpt::maps::COccupancyGridMap2D::cellType cell);
  * (ROS map_server: image = `imageName`, mode scale, negate 0, origin = lower-left
  * corner). Throws std::runtime_error on I/O errors. */
 void writeRosMap(
-	const mrpt::maps::COccupancyGridMap2D& grid, const std::string& yamlPath,
-	const std::string& pgmPath, const std::string& imageName);
+	const mrpt::maps::COccupancyGridMap2D& grid, const std::string& yamlPath, const std::string& pgmPath,
+	const std::string& imageName);
 
 /** A plain COccupancyGridMap2D copy of `grid` (also of derived classes),
  * gzip-serialized: stock MRPT reads it with

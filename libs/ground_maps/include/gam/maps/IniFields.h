@@ -100,7 +100,8 @@ void write(const P& p, mrpt::serialization::CArchive& out)
 	uint32_t n = 0;
 	P::forEachParam(p, [&](const ParamInfo&, const auto&) { n++; });
 	out << n;
-	P::forEachParam(p, [&](const ParamInfo& info, const auto& value) { out << std::string(info.key) << double(value); });
+	P::forEachParam(
+		p, [&](const ParamInfo& info, const auto& value) { out << std::string(info.key) << double(value); });
 }
 
 /** Reads what write() wrote (any P: unknown keys are skipped). Throws

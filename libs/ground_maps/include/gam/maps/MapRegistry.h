@@ -28,18 +28,18 @@ struct IniSection
 /** Where and how a map's outputs are written. */
 struct OutputContext
 {
-	std::string dir;  ///< folder (exists)
-	std::string label;	///< file name stem
-	bool localMap = false;	///< robot-centred window mode
-	double robotX = 0, robotY = 0;	///< last robot position (map frame)
-	int localCells = 600;  ///< window size [cells]
+	std::string dir;                ///< folder (exists)
+	std::string label;              ///< file name stem
+	bool localMap = false;          ///< robot-centred window mode
+	double robotX = 0, robotY = 0;  ///< last robot position (map frame)
+	int localCells = 600;           ///< window size [cells]
 };
 
 /** Ground plane of the last depth frame, for ground_planes.csv. */
 struct GroundPlaneRecord
 {
 	bool found = false;
-	double a = 0, b = 0, c = 0, d = 0;	///< a x + b y + c z + d = 0
+	double a = 0, b = 0, c = 0, d = 0;  ///< a x + b y + c z + d = 0
 	size_t nodes = 0;
 	std::string status;
 };

@@ -42,8 +42,8 @@ bool binObservation(
 
 /** Bins a point cloud given in the frame `pose` (points are first mapped by it). */
 size_t binPointCloud(
-	const mrpt::maps::CPointsMap& pts, const mrpt::poses::CPose3D& pose,
-	const ProjectionFilter& f, const ElevationGrid& grid, BinnedPoints& out);
+	const mrpt::maps::CPointsMap& pts, const mrpt::poses::CPose3D& pose, const ProjectionFilter& f,
+	const ElevationGrid& grid, BinnedPoints& out);
 
 /** Checks a 3D scan before it reaches MRPT code that trusts it (the comparison
  * maps hand it to convertTo2DScan() / unprojectInto()): finite sensorPose; for a

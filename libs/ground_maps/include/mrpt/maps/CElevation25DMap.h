@@ -7,7 +7,6 @@
 #include <mrpt/obs/obs_frwds.h>
 #include <mrpt/poses/CPose3D.h>
 
-
 #include "gam/core/DepthProjector.h"
 #include "gam/core/ElevationGrid.h"
 
@@ -45,8 +44,7 @@ class CElevation25DMap : public CMetricMap
 
    public:
 	CElevation25DMap(
-		double x_min = -5, double x_max = 5, double y_min = -5, double y_max = 5,
-		double resolution = 0.05);
+		double x_min = -5, double x_max = 5, double y_min = -5, double y_max = 5, double resolution = 0.05);
 
 	/** Re-creates the grid (empties it). Throws std::invalid_argument. */
 	void setSize(double x_min, double x_max, double y_min, double y_max, double resolution);
@@ -59,8 +57,8 @@ class CElevation25DMap : public CMetricMap
 		/** z_min, z_max in the map frame [m]; ranges along the sensor axis / ray
 		 * [m] (the observation's own maxRange applies too); decimation of range images. */
 		gam::ProjectionFilter projection = {0.0f, 10.0f, -2.0f, 3.0f, 1};
-		gam::OutlierFilterParams outliers;	///< the 3-sigma rule per cell and frame
-		gam::IdwParams idw = {0, 2.0f, 3};	///< radius 0 = no densification
+		gam::OutlierFilterParams outliers;  ///< the 3-sigma rule per cell and frame
+		gam::IdwParams idw = {0, 2.0f, 3};  ///< radius 0 = no densification
 
 		template <class Self, class Visit>
 		static void forEachParam(Self& o, Visit&& visit)
@@ -121,10 +119,7 @@ class CElevation25DMap : public CMetricMap
 	{
 		return 0;
 	}
-	bool internal_canComputeObservationLikelihood(const mrpt::obs::CObservation& obs) const override
-	{
-		return false;
-	}
+	bool internal_canComputeObservationLikelihood(const mrpt::obs::CObservation& obs) const override { return false; }
 
    private:
 	void finishInsertion();

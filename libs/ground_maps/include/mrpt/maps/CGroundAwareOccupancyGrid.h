@@ -51,8 +51,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 
    public:
 	CGroundAwareOccupancyGrid(
-		float min_x = -10.0f, float max_x = 10.0f, float min_y = -10.0f, float max_y = 10.0f,
-		float resolution = 0.05f);
+		float min_x = -10.0f, float max_x = 10.0f, float min_y = -10.0f, float max_y = 10.0f, float resolution = 0.05f);
 
 	/** Every ground-aware parameter; defaults = paper Table I. */
 	struct TGroundAwareOptions : public mrpt::config::CLoadableOptions
@@ -61,7 +60,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		 * RRT-GPD, ISM); d_r is the grid resolution, from _creationOpts. */
 		gam::PipelineParams pipeline;
 		// 2D scans
-		int sparse_scan_upsampling = 8;	 ///< rays per beam for scans of < 64 beams (Leddar)
+		int sparse_scan_upsampling = 8;  ///< rays per beam for scans of < 64 beams (Leddar)
 		/** A planar beam passes over holes, cables and small boxes: with this
 		 * on, 2D scans add their hits and reinforce cells already free, but
 		 * never make an unknown or occupied cell freer (only seen floor is free). */
@@ -72,10 +71,12 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		static void forEachParam(Self& o, Visit&& visit)
 		{
 			gam::PipelineParams::forEachParam(o.pipeline, visit);
-			visit(gam::ParamInfo{"sparse_scan_upsampling", 1, 1000, "rays per beam for scans with < 64 beams"},
-				  o.sparse_scan_upsampling);
-			visit(gam::ParamInfo{"scan_keeps_3d_obstacles", 0, 1, "2D scans free only cells already free (seen floor)"},
-				  o.scan_keeps_3d_obstacles);
+			visit(
+				gam::ParamInfo{"sparse_scan_upsampling", 1, 1000, "rays per beam for scans with < 64 beams"},
+				o.sparse_scan_upsampling);
+			visit(
+				gam::ParamInfo{"scan_keeps_3d_obstacles", 0, 1, "2D scans free only cells already free (seen floor)"},
+				o.scan_keeps_3d_obstacles);
 		}
 		/** Loads and validates (throws std::invalid_argument naming the key). */
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
@@ -92,8 +93,8 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	/** Map-side times of the last 3D frame; the pipeline's stages are in lastFrame().ms. */
 	struct TFrameTimes
 	{
-		double update = 0;	///< log-odds fusion into this grid [ms]
-		double total = 0;  ///< the whole insertion [ms]
+		double update = 0;  ///< log-odds fusion into this grid [ms]
+		double total = 0;   ///< the whole insertion [ms]
 	};
 	/** What happened to the last 3D frame (for apps, viewers and logs). */
 	const gam::FrameResult& lastFrame() const { return m_pipeline.result(); }
@@ -125,8 +126,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
    private:
 	bool insert3D(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose);
 	bool insert2D(
-		const mrpt::obs::CObservation2DRangeScan& scan,
-		const std::optional<const mrpt::poses::CPose3D>& robotPose);
+		const mrpt::obs::CObservation2DRangeScan& scan, const std::optional<const mrpt::poses::CPose3D>& robotPose);
 	void applyEvidence();
 
 	TGroundAwareOptions m_options;

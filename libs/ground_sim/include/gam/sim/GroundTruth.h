@@ -27,27 +27,22 @@
 #pragma once
 
 #include <vector>
+#include "gam/common/GroundTruthLabels.h"
 
 #include "gam/sim/Scene.h"
 
 namespace gam::sim
 {
-enum class Label : uint8_t
-{
-	Free = 0,
-	Obstacle = 1,
-	Drop = 2,
-	Unobserved = 3
-};
-const char* labelName(Label l);
+using Label = gam::GroundTruthLabel;
+using gam::labelName;
 
 struct GridSpec
 {
 	double resolution = 0.05;
 	double min_x = -1, max_x = 5, min_y = -3, max_y = 3;
-	double robot_height = 1.90;	 ///< walker + user: overhangs below it block
-	double obstacle_min_height = 0.02;	///< smallest bump that counts [m]
-	double drop_min_depth = 0.02;  ///< smallest drop that counts [m]
+	double robot_height = 1.90;         ///< walker + user: overhangs below it block
+	double obstacle_min_height = 0.02;  ///< smallest bump that counts [m]
+	double drop_min_depth = 0.02;       ///< smallest drop that counts [m]
 	double small_max_height = 0.20;
 	double overhang_clearance = 0.10;
 	double max_slope_deg = 10.0;

@@ -10,19 +10,19 @@ namespace gam::sim
 struct Pose2
 {
 	double x = 0, y = 0, yaw = 0;
-	Pose2 compose(const Pose2& d) const;  ///< this ⊕ d
-	Pose2 inverseCompose(const Pose2& b) const;	 ///< this ⊖ b (b⁻¹ ⊕ this)
+	Pose2 compose(const Pose2& d) const;         ///< this ⊕ d
+	Pose2 inverseCompose(const Pose2& b) const;  ///< this ⊖ b (b⁻¹ ⊕ this)
 };
 
 double wrapPi(double a);
 
 struct PathSpec
 {
-	std::vector<Pose2> waypoints;  ///< at least one
-	double spacing = 0.10;	///< metres between frames along straight parts
+	std::vector<Pose2> waypoints;              ///< at least one
+	double spacing = 0.10;                     ///< metres between frames along straight parts
 	double turn_spacing = 5.0 * M_PI / 180.0;  ///< radians between frames while turning
-	int frames = 0;	 ///< single-waypoint path: number of frames to take there (>=1)
-	double rate_hz = 10.0;	///< frame rate, for timestamps
+	int frames = 0;                            ///< single-waypoint path: number of frames to take there (>=1)
+	double rate_hz = 10.0;                     ///< frame rate, for timestamps
 };
 
 /** Frames along the polyline of waypoints: the yaw is interpolated linearly
@@ -37,13 +37,12 @@ std::vector<Pose2> samplePath(const PathSpec& spec);
 struct OdometryNoise
 {
 	double xy_per_m = 0.0;
-	double yaw_per_m = 0.0;	 ///< radians per metre
+	double yaw_per_m = 0.0;  ///< radians per metre
 	double yaw_per_rad = 0.0;
 	bool enabled() const { return xy_per_m > 0 || yaw_per_m > 0 || yaw_per_rad > 0; }
 };
 
 /** The absolute odometry readings for the true path (starts at truth[0]). */
-std::vector<Pose2> simulateOdometry(
-	const std::vector<Pose2>& truth, const OdometryNoise& n, std::mt19937& rng);
+std::vector<Pose2> simulateOdometry(const std::vector<Pose2>& truth, const OdometryNoise& n, std::mt19937& rng);
 
 }  // namespace gam::sim

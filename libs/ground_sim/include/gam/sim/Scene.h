@@ -21,12 +21,12 @@ namespace gam::sim
 /** Object categories written in the ground truth (see GroundTruth.h). */
 enum class Category : int
 {
-	None = 0,  ///< plain floor
+	None = 0,      ///< plain floor
 	Negative = 1,  ///< below the floor: holes, outlets, downward stairs
-	Small = 2,	///< obstacle lower than GroundTruthParams::small_max_height
+	Small = 2,     ///< obstacle lower than GroundTruthParams::small_max_height
 	Overhang = 3,  ///< has a part floating above the floor (table top, shelf boards)
-	Large = 4,	///< any other obstacle
-	Ramp = 5  ///< traversable slope (label free)
+	Large = 4,     ///< any other obstacle
+	Ramp = 5       ///< traversable slope (label free)
 };
 const char* categoryName(Category c);
 /** Parses "negative", "small", ... (returns false if unknown). */
@@ -40,7 +40,7 @@ struct Pose3
 	/** MRPT CPose3D convention: R = Rz(yaw) * Ry(pitch) * Rx(roll), angles in
 	 * radians. Positive pitch turns +X towards -Z (nose down). */
 	static Pose3 fromXYZYPR(double x, double y, double z, double yaw, double pitch, double roll);
-	Pose3 operator*(const Pose3& o) const;	///< composition (this ⊕ o)
+	Pose3 operator*(const Pose3& o) const;  ///< composition (this ⊕ o)
 	Eigen::Vector3d apply(const Eigen::Vector3d& p) const { return R * p + t; }
 	/** yaw, pitch, roll (radians) of R in the same convention. */
 	Eigen::Vector3d ypr() const;
@@ -82,26 +82,21 @@ struct Hole
 		Rect,
 		Circle
 	} shape = Rect;
-	double cx = 0, cy = 0;	///< centre
-	double hx = 0, hy = 0;	///< half sizes (Rect)
-	double yaw = 0;	 ///< radians (Rect)
-	double r = 0;  ///< radius (Circle)
-	double depth = 0.1;	 ///< metres, > 0, may be infinity
+	double cx = 0, cy = 0;  ///< centre
+	double hx = 0, hy = 0;  ///< half sizes (Rect)
+	double yaw = 0;         ///< radians (Rect)
+	double r = 0;           ///< radius (Circle)
+	double depth = 0.1;     ///< metres, > 0, may be infinity
 	int object_id = 0;
 
 	bool containsXY(double x, double y) const;
 	/** Interior of the pit volume (open above, below z=0): strict xy inside and
 	 * z > -depth. */
-	bool containsXYZ(const Eigen::Vector3d& p) const
-	{
-		return containsXY(p.x(), p.y()) && p.z() > -depth;
-	}
+	bool containsXYZ(const Eigen::Vector3d& p) const { return containsXY(p.x(), p.y()) && p.z() > -depth; }
 	/** Where a ray inside the pit leaves it through its walls or bottom
 	 * (t > tmin). Sets the inward-facing normal of the surface hit. Returns
 	 * +inf if it never leaves (bottomless, going down). */
-	double exitT(
-		const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double tmin,
-		Eigen::Vector3d& normal) const;
+	double exitT(const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double tmin, Eigen::Vector3d& normal) const;
 };
 
 /** Static description of a scene object (for the ground-truth list). */
@@ -112,8 +107,8 @@ struct ObjectInfo
 	std::string type;  ///< primitive keyword: box, hole, stairs_down, ...
 	Category category = Category::Large;
 	bool category_given = false;  ///< set explicitly in the scene file
-	bool traversable = false;  ///< ramps within the slope limit (set by GroundTruthGrid::build)
-	double slope_deg = 0;  ///< ramps: surface slope
+	bool traversable = false;     ///< ramps within the slope limit (set by GroundTruthGrid::build)
+	double slope_deg = 0;         ///< ramps: surface slope
 	Eigen::AlignedBox3d bbox;
 };
 
@@ -121,16 +116,16 @@ struct ObjectInfo
 struct RayHit
 {
 	bool hit = false;
-	double t = std::numeric_limits<double>::infinity();	 ///< ray parameter
+	double t = std::numeric_limits<double>::infinity();  ///< ray parameter
 	Eigen::Vector3d point = Eigen::Vector3d::Zero();
-	Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();	///< surface normal, facing the ray origin side
-	int object_id = 0;	///< 0 = plain floor
+	Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< surface normal, facing the ray origin side
+	int object_id = 0;                                  ///< 0 = plain floor
 };
 
 class Scene
 {
    public:
-	bool has_floor = true;	///< floor plane z=0 (solid below)
+	bool has_floor = true;  ///< floor plane z=0 (solid below)
 	std::vector<Hole> holes;
 	std::vector<ConvexSolid> solids;
 	std::vector<ObjectInfo> objects;
@@ -151,9 +146,7 @@ class Scene
 
    private:
 	/** Floor+pits only. */
-	bool castGround(
-		const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double tmin, double tmax,
-		RayHit& h) const;
+	bool castGround(const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double tmin, double tmax, RayHit& h) const;
 };
 
 }  // namespace gam::sim

@@ -67,7 +67,7 @@ struct SceneFile
 	LeddarParams leddar;
 	Pose3 leddar_pose = Pose3::fromXYZYPR(0.20, 0, 0.30, 0, 0, 0);
 	bool leddar_enabled = true;
-	double kinect_sway = 0;	 ///< radians, sigma of the per-frame pitch/roll perturbation
+	double kinect_sway = 0;  ///< radians, sigma of the per-frame pitch/roll perturbation
 	PathSpec path;
 	OdometryNoise odometry_noise;
 	GridSpec grid;

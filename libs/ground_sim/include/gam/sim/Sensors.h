@@ -78,20 +78,20 @@ struct KinectParams
 enum PixelFlag : uint8_t
 {
 	PixValid = 1,
-	PixDropout = 2,	 ///< removed by the grazing-angle model
-	PixFlying = 4,	///< mixed depth at an edge
+	PixDropout = 2,  ///< removed by the grazing-angle model
+	PixFlying = 4,   ///< mixed depth at an edge
 	PixSpike = 8,
-	PixOutOfRange = 16,	 ///< no surface in [min_range, max_range]
-	PixEdge = 32  ///< lies on a true depth discontinuity
+	PixOutOfRange = 16,  ///< no surface in [min_range, max_range]
+	PixEdge = 32         ///< lies on a true depth discontinuity
 };
 
 struct DepthFrame
 {
 	int width = 0, height = 0;
-	std::vector<float> depth;  ///< simulated depth along +X [m], 0 = no return
-	std::vector<float> true_depth;	///< exact depth [m], +inf = no surface within 20 m
-	std::vector<float> incidence;  ///< incidence angle [rad] of the true hit
-	std::vector<int> object_id;	 ///< id of the surface hit (0 floor / none)
+	std::vector<float> depth;       ///< simulated depth along +X [m], 0 = no return
+	std::vector<float> true_depth;  ///< exact depth [m], +inf = no surface within 20 m
+	std::vector<float> incidence;   ///< incidence angle [rad] of the true hit
+	std::vector<int> object_id;     ///< id of the surface hit (0 floor / none)
 	std::vector<uint8_t> flags;
 	/** Geometric visible footprint (noise-free): world xy of every true hit
 	 * within the valid range (5 mm inside the surface hit), plus the z=0
