@@ -641,3 +641,46 @@ TEST(InverseSensorModel, LoneSamplesGiveNoObstacleEvidence)
 	p.min_obstacle_points = 0;
 	EXPECT_THROW(InverseSensorModel{p}, std::invalid_argument);
 }
+
+TEST(InverseSensorModel, FloorNoiseIsMeasuredPerRangeBin)
+{
+	// Sensor 1 m above the floor plane z = 0 at the origin. Two floor strips
+	// (|y| <= 0.1 m), each cell with the 4 samples +a, -a, +a, -a: mean 0,
+	// sample std a (sqrt of (4 a^2) / 4 - 0^2).
+	//   near: x in [0.5, 0.9): 3D range sqrt(x^2 + y^2 + 1) in [1.118, 1.35), a = 1 cm, 8 x 4 = 32 cells
+	//   far:  x in [1.2, 1.7): 3D range in [1.56, 1.98),                a = 2 cm, 10 x 4 = 40 cells
+	ElevationGrid frame(gamtest::makeGeometry(-1, -1, 0.05, 60, 40));
+	const GridGeometry& g = frame.geometry();
+	BinnedPoints pts;
+	for (int iy = g.iy(-0.1 + 1e-6); iy < g.iy(0.1 - 1e-6) + 1; iy++)
+		for (int ix = g.ix(0.5 + 1e-6); ix < g.ix(1.7 - 1e-6) + 1; ix++)
+		{
+			const double x = g.cx(ix);
+			if (x > 0.9 && x < 1.2) continue;
+			const float a = x < 1.0 ? 0.01f : 0.02f;
+			for (float z : {a, -a, a, -a}) pts.push(uint32_t(g.index(ix, iy)), z);
+		}
+	frame.insert(pts, OutlierFilterParams{});
+	const Eigen::Vector3d sensor(0, 0, 1);
+	IsmStats st;
+
+	// Bins of 0.5 m: [1.0, 1.5) holds only the near strip, [1.5, 2.0) only the
+	// far one, so the band is d_pth + noise_sigmas * a = 0.03 + 3 * 0.01 = 0.06
+	// at 1.25 m and 0.03 + 3 * 0.02 = 0.09 at 1.75 m.
+	InverseSensorModel half;
+	half.compute(frame, handDetection(kFloor), sensor, 5.0, st);
+	EXPECT_NEAR(half.groundBand(sensor, 1.0, std::sqrt(1.25 * 1.25 - 1), 0, 0), 0.06, 1e-6);
+	EXPECT_NEAR(half.groundBand(sensor, 1.0, std::sqrt(1.75 * 1.75 - 1), 0, 0), 0.09, 1e-6);
+
+	// One bin of 1 m, [1.0, 2.0): 72 cells, 40 of them with 2 cm, so the
+	// median is 2 cm and the band 0.09 at both ranges.
+	IsmParams p;
+	p.floor_noise_bin = 1.0;
+	InverseSensorModel whole(p);
+	whole.compute(frame, handDetection(kFloor), sensor, 5.0, st);
+	EXPECT_NEAR(whole.groundBand(sensor, 1.0, std::sqrt(1.25 * 1.25 - 1), 0, 0), 0.09, 1e-6);
+	EXPECT_NEAR(whole.groundBand(sensor, 1.0, std::sqrt(1.75 * 1.75 - 1), 0, 0), 0.09, 1e-6);
+
+	p.floor_noise_bin = 0;  // below its range 0.05 .. 10 m
+	EXPECT_THROW(InverseSensorModel{p}, std::invalid_argument);
+}

@@ -30,7 +30,7 @@ double InverseSensorModel::groundBand(const Eigen::Vector3d& sensor, double h, d
 	if (r < 1e-3) return m_params.d_pth;
 	// The floor's vertical scatter measured in this frame at this range, if
 	// enough floor was seen there; else the sensor model.
-	const size_t bin = size_t(r / kNoiseBin);
+	const size_t bin = size_t(r / m_params.floor_noise_bin);
 	if (bin < m_floorNoise.size() && m_floorNoise[bin] >= 0)
 		return m_params.d_pth + m_params.noise_sigmas * double(m_floorNoise[bin]);
 	const double sd = m_params.depth_noise_c0 + m_params.depth_noise_c2 * r * r;
@@ -45,7 +45,7 @@ void InverseSensorModel::measureFloorNoise(
 	// vertical scatter of the sensor at their range: their sample std. The
 	// median per range bin is robust to the odd obstacle cell among them.
 	const GridGeometry& g = frame.geometry();
-	const size_t nb = size_t(std::ceil((m_maxRange + 1.0) / kNoiseBin));
+	const size_t nb = size_t(std::ceil((m_maxRange + 1.0) / m_params.floor_noise_bin));
 	m_floorNoise.assign(nb, -1.f);
 	if (!m_params.measure_floor_noise || m_params.noise_sigmas <= 0) return;
 	m_noiseBin.clear();
@@ -60,7 +60,7 @@ void InverseSensorModel::measureFloorNoise(
 		const Plane& pl = choosePlane(det, c, x, y, block);
 		if (std::abs(pl.signedDistance(x, y, c.mean())) > m_params.d_pth) continue;
 		const Eigen::Vector3d d(x - sensor.x(), y - sensor.y(), c.mean() - sensor.z());
-		const size_t bin = size_t(d.norm() / kNoiseBin);
+		const size_t bin = size_t(d.norm() / m_params.floor_noise_bin);
 		if (bin < nb)
 		{
 			m_noiseBin.push_back(uint32_t(bin));

@@ -39,6 +39,7 @@ struct IsmParams
 	 * their own noise needs, with no per-sensor tuning. */
 	bool measure_floor_noise = true;
 	int floor_noise_min_cells = 10;
+	double floor_noise_bin = 0.5;  ///< range bin of the measured floor noise [m]
 	/** Obstacle and drop voxels with fewer samples give no evidence. Any real
 	 * surface within a depth camera's range fills a d_r cell with several
 	 * samples (a 5 cm cell of floor 4.5 m away from a 512x424 Kinect One
@@ -86,8 +87,9 @@ struct IsmParams
 				"band from the floor's scatter measured in each frame (model where too little floor)"},
 			p.measure_floor_noise);
 		visit(
-			ParamInfo{"floor_noise_min_cells", 1, 1000000, "floor cells a 0.5 m range bin needs to be measured"},
+			ParamInfo{"floor_noise_min_cells", 1, 1000000, "floor cells a range bin needs to be measured"},
 			p.floor_noise_min_cells);
+		visit(ParamInfo{"floor_noise_bin", 0.05, 10, "range bin of the measured floor noise [m]"}, p.floor_noise_bin);
 		visit(ParamInfo{"robot_height", 1e-3, 100, "voxels entirely above this do not block [m]"}, p.robot_height);
 		visit(ParamInfo{"drop_rays", 0, 1, "mark cells where rays went below the ground"}, p.drop_rays);
 		visit(ParamInfo{"max_drop_ray_length", 0, 100, "longest drop ray [m]"}, p.max_drop_ray_length);
@@ -183,8 +185,7 @@ class InverseSensorModel
 	void buildSupport(const GridGeometry& g, const GroundDetection& det);
 	void measureFloorNoise(const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor);
 
-	static constexpr double kNoiseBin = 0.5;  ///< range bin of the floor noise [m]
-	std::vector<float> m_floorNoise;          ///< per bin: measured std [m], < 0 = not measured
+	std::vector<float> m_floorNoise;  ///< per bin: measured std [m], < 0 = not measured
 	// Floor samples of all bins in one buffer (bounded by the cell count, so
 	// never reallocated per frame): (bin, std) pairs, then grouped by bin.
 	std::vector<uint32_t> m_noiseBin;
