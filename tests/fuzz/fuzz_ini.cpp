@@ -32,9 +32,10 @@ bool bounded(const TSetOfMetricMapInitializers& inits)
 	{
 		if (const auto* g = dynamic_cast<const CGroundAwareOccupancyGrid::TMapDefinition*>(i.get()))
 		{
-			const auto& o = g->groundOpts;
+			const gam::PipelineParams& o = g->groundOpts.pipeline;
 			if (!small(g->min_x, g->max_x, g->min_y, g->max_y, g->resolution) || double(o.m_x) * o.m_y > 1 << 18 ||
-				o.K > 2000 || o.ransac_iterations > 2000 || o.idw_radius > 5 || o.seed_attempts > 10)
+				o.rrt.iterations > 2000 || o.rrt.ransac_iterations > 2000 || o.idw.radius_cells > 5 ||
+				o.rrt.seed_attempts > 10)
 				return false;
 		}
 		else if (const auto* h = dynamic_cast<const CHeightBandOccupancyGrid::TMapDefinition*>(i.get()))
