@@ -21,7 +21,6 @@ namespace gam::mapper
 {
 namespace
 {
-std::string firstLine(const std::string& s) { return conciseError(s); }
 
 bool validLabel(const std::string& l)
 {
@@ -157,7 +156,7 @@ void loadMapDefinitions(
 			}
 			catch (const std::exception& e)
 			{
-				throw ConfigError(firstLine(e.what()));
+				throw ConfigError(conciseError(e.what()));
 			}
 
 			std::string defLabel = name + "_" + nn;

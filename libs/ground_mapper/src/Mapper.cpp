@@ -25,7 +25,6 @@ namespace gam::mapper
 {
 namespace
 {
-std::string firstLine(const std::string& s) { return conciseError(s); }
 
 std::string fmtMs(double v)
 {
@@ -94,7 +93,7 @@ Mapper::Mapper(const MapperOptions& opts) : m_opts(opts)
 	}
 	catch (const std::exception& e)
 	{
-		throw ConfigError(m_opts.configName + ": cannot create the maps: " + firstLine(e.what()));
+		throw ConfigError(m_opts.configName + ": cannot create the maps: " + conciseError(e.what()));
 	}
 	if (m_maps.maps.size() != m_specs.size())
 		throw ConfigError("internal: CMultiMetricMap created a different number of maps than the .ini defines");
@@ -214,7 +213,7 @@ RunSummary Mapper::run()
 				{
 					throw RunError(
 						"frame " + std::to_string(fr.index) + " (rawlog entry " + std::to_string(fr.entry) + "), map " +
-						m_specs[i].label + ": " + firstLine(e.what()));
+						m_specs[i].label + ": " + conciseError(e.what()));
 				}
 				const double ms = std::chrono::duration<double, std::milli>(clk::now() - t0).count();
 				s.maps[i].totalMs.push_back(ms);
@@ -286,7 +285,7 @@ RunSummary Mapper::run()
 	}
 	catch (const std::exception& e)
 	{
-		throw RunError("writing outputs: " + firstLine(e.what()));
+		throw RunError("writing outputs: " + conciseError(e.what()));
 	}
 	s.files.push_back("timing.csv");
 	s.files.push_back("ground_planes.csv");

@@ -54,8 +54,7 @@ void CElevation25DMap::TMapDefinition::loadFromConfigFile_map_specific(
 	const std::string sC = sectionNamePrefix + "_creationOpts";
 	gam::maps::ini::loadGridExtent(source, sC, min_x, max_x, min_y, max_y, resolution);
 	// ElevationGrid has its own (smaller) cell limit: refuse before allocating.
-	try
-	{
+	gam::maps::ini::checkInSection(sC, [&] {
 		gam::GridGeometry g;
 		g.x_min = min_x;
 		g.y_min = min_y;
@@ -63,11 +62,7 @@ void CElevation25DMap::TMapDefinition::loadFromConfigFile_map_specific(
 		g.nx = int(std::lround((max_x - min_x) / resolution));
 		g.ny = int(std::lround((max_y - min_y) / resolution));
 		g.validate();
-	}
-	catch (const std::invalid_argument& e)
-	{
-		throw std::invalid_argument(gam::maps::ini::sectionContext(sC) + " " + e.what());
-	}
+	});
 	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 }
 

@@ -12,6 +12,18 @@ namespace gam::maps::ini
 {
 std::string sectionContext(const std::string& section) { return "in section '" + section + "':"; }
 
+void checkInSection(const std::string& section, const std::function<void()>& check)
+{
+	try
+	{
+		check();
+	}
+	catch (const std::invalid_argument& e)
+	{
+		throw std::invalid_argument(sectionContext(section) + " " + e.what());
+	}
+}
+
 std::string readRaw(const mrpt::config::CConfigFileBase& src, const std::string& section, const std::string& key)
 {
 	return gam::stripIniComment(src.read_string(section, key, "", false));

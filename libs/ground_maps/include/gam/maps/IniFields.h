@@ -1,7 +1,7 @@
 // Ground-aware mapping for MRPT
 // The .ini binding of parameter structs that list their fields with
 // forEachParam (gam/core/Parameters.h): loading, saving, unknown-key
-// detection, serialization and --print-config dumps all walk that one list,
+// detection and serialization all walk that one list,
 // so a key, its range and its meaning are written down exactly once.
 #pragma once
 
@@ -10,7 +10,6 @@
 
 #include <cstdint>
 #include <functional>
-#include <sstream>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -50,21 +49,17 @@ void load(P& p, const mrpt::config::CConfigFileBase& src, const std::string& sec
 	});
 }
 
-/** load(), then `check` (e.g. the struct's validate(), for rules that involve
- * several keys); a std::invalid_argument it throws gets the section in front. */
+/** Runs `check` (rules that involve several keys, e.g. a struct's validate());
+ * a std::invalid_argument it throws gets "in section 'S':" in front. */
+void checkInSection(const std::string& section, const std::function<void()>& check);
+
+/** load(), then checkInSection(section, check). */
 template <class P>
 void loadThenCheck(
 	P& p, const mrpt::config::CConfigFileBase& src, const std::string& section, const std::function<void()>& check)
 {
 	load(p, src, section);
-	try
-	{
-		check();
-	}
-	catch (const std::invalid_argument& e)
-	{
-		throw std::invalid_argument(sectionContext(section) + " " + e.what());
-	}
+	checkInSection(section, check);
 }
 
 template <class P>
@@ -126,22 +121,6 @@ void read(P& p, mrpt::serialization::CArchive& in, const char* who)
 				value = T(v);
 		});
 	}
-}
-
-/** "key = value  ; lo to hi: help" lines, for --print-config style dumps. */
-template <class P>
-std::string describe(const P& p)
-{
-	std::ostringstream s;
-	P::forEachParam(p, [&](const ParamInfo& info, const auto& value) {
-		s << info.key << " = ";
-		if constexpr (std::is_same_v<std::remove_cv_t<std::remove_reference_t<decltype(value)>>, bool>)
-			s << (value ? "true" : "false");
-		else
-			s << value;
-		s << "\t; " << info.lo << " to " << info.hi << ": " << info.help << "\n";
-	});
-	return s.str();
 }
 
 /** The `_creationOpts` of a 2D grid map: min_x, max_x, min_y, max_y and
