@@ -225,6 +225,45 @@ TEST(InverseSensorModel, ClassifyAgainstAPlane)
 	EXPECT_EQ(ism.classify(cellOf({1.0f, 1.2f}), 1, 1, kFloor, band, d), VoxelClass::Overhead);
 }
 
+TEST(InverseSensorModel, ClassifyByTheMeanOfNSamples)
+{
+	// Issue #17, second cause: a 4 cm cable protector or the bottom of a 5 cm
+	// pit 4 m away lies inside the one-sample ground band there (measured floor
+	// scatter ~8 mm: d_pth + 3 sigma = 0.03 + 0.024 = 0.054). Each sample alone
+	// is plausible floor; 9 of them at +4 cm are not. Band of one sample here:
+	// 0.045 = d_pth 0.03 + noise part 0.015. The mean of N samples has a noise
+	// part 0.015 / sqrt(N); the d_pth part (plane error, uneven floor) stays.
+	InverseSensorModel ism;
+	const double band = 0.045;
+	double d = 0;
+	auto cellOfN = [](int n, float z) {
+		ElevationCell c;
+		for (int i = 0; i < n; i++) c.add(z);
+		return c;
+	};
+	// N = 9: band of the mean 0.03 + 0.015 / 3 = 0.035 < 0.04.
+	EXPECT_EQ(ism.classify(cellOfN(9, 0.04f), 1, 1, kFloor, band, d), VoxelClass::Obstacle);
+	EXPECT_EQ(ism.classify(cellOfN(9, -0.04f), 1, 1, kFloor, band, d), VoxelClass::Drop);
+	// N = 4: 0.03 + 0.015 / 2 = 0.0375 > 0.036: still floor.
+	EXPECT_EQ(ism.classify(cellOfN(4, 0.036f), 1, 1, kFloor, band, d), VoxelClass::Ground);
+	// N = 9 at 0.036 > 0.035: not floor.
+	EXPECT_EQ(ism.classify(cellOfN(9, 0.036f), 1, 1, kFloor, band, d), VoxelClass::Obstacle);
+	// One sample: the one-sample band (0.04 < 0.045 is floor).
+	EXPECT_EQ(ism.classify(cellOfN(1, 0.04f), 1, 1, kFloor, band, d), VoxelClass::Ground);
+	// Never narrower than d_pth, however many samples: 10000 at +2.9 cm are floor.
+	EXPECT_EQ(ism.classify(cellOfN(10000, 0.029f), 1, 1, kFloor, band, d), VoxelClass::Ground);
+	// Samples spread over the band with a mean near the plane: floor.
+	EXPECT_EQ(ism.classify(cellOf({-0.04f, 0.04f, -0.03f, 0.03f, 0.0f}), 1, 1, kFloor, band, d), VoxelClass::Ground);
+	// A band that is all d_pth (noise_sigmas = 0, the paper's) has no noise part to shrink.
+	EXPECT_EQ(ism.classify(cellOfN(9, 0.029f), 1, 1, kFloor, 0.03, d), VoxelClass::Ground);
+
+	IsmParams p;
+	p.mean_test = false;  // only z_min / z_max against the one-sample band
+	ism.setParams(p);
+	EXPECT_EQ(ism.classify(cellOfN(9, 0.04f), 1, 1, kFloor, band, d), VoxelClass::Ground);
+	EXPECT_EQ(ism.classify(cellOfN(9, -0.04f), 1, 1, kFloor, band, d), VoxelClass::Ground);
+}
+
 namespace
 {
 // Frame of test ISM-1 (grid -5..5 m, 5 cm). Sensor at (0, 0, 1), ground z = 0.

@@ -25,6 +25,24 @@ std::vector<Box> holeAndBoxScene()
 }
 
 double pOcc(const COccupancyGridMap2D& g, double x, double y) { return 1.0 - g.getPos(float(x), float(y)); }
+
+// A Leddar IS16 (16 segments over 45 deg) 0.3 m up, seeing a wall 3 m ahead.
+mrpt::obs::CObservation2DRangeScan leddarWallScan()
+{
+	mrpt::obs::CObservation2DRangeScan s;
+	s.aperture = float(DEG2RAD(45.0));
+	s.rightToLeft = true;
+	s.maxRange = 50;
+	s.sensorPose = CPose3D(0.2, 0, 0.3, 0, 0, 0);
+	s.resizeScan(16);
+	for (size_t i = 0; i < 16; i++)
+	{
+		const double a = -s.aperture / 2 + (i + 0.5) * s.aperture / 16;
+		s.setScanRange(i, float(2.8 / std::cos(a)));  // wall at x = 3.0 in the robot frame
+		s.setScanRangeValidity(i, true);
+	}
+	return s;
+}
 }  // namespace
 
 TEST(GroundAwareGrid, FloorFreeBoxAndHoleOccupied)
@@ -164,19 +182,7 @@ TEST(GroundAwareGrid, EvidenceAccumulatesOverFrames)
 
 TEST(GroundAwareGrid, LeddarScanFusesThroughTheBeamModel)
 {
-	// 16 segments over 45 deg, a wall 3 m ahead.
-	mrpt::obs::CObservation2DRangeScan s;
-	s.aperture = float(DEG2RAD(45.0));
-	s.rightToLeft = true;
-	s.maxRange = 50;
-	s.sensorPose = CPose3D(0.2, 0, 0.3, 0, 0, 0);
-	s.resizeScan(16);
-	for (size_t i = 0; i < 16; i++)
-	{
-		const double a = -s.aperture / 2 + (i + 0.5) * s.aperture / 16;
-		s.setScanRange(i, float(2.8 / std::cos(a)));  // wall at x = 3.0 in the robot frame
-		s.setScanRangeValidity(i, true);
-	}
+	const auto s = leddarWallScan();
 	CGroundAwareOccupancyGrid g, plain;
 	auto beamModel = plain.groundOptions();
 	beamModel.scan_keeps_3d_obstacles = false;
@@ -199,17 +205,7 @@ TEST(GroundAwareGrid, LeddarBeamsOverAHoleDoNotClearIt)
 	// The Leddar at 0.3 m sees the wall at 3 m over the hole and the box: its
 	// free-space rays must not erase what the depth camera found below them.
 	auto scene = holeAndBoxScene();
-	mrpt::obs::CObservation2DRangeScan s;
-	s.aperture = float(DEG2RAD(45.0));
-	s.maxRange = 50;
-	s.sensorPose = CPose3D(0.2, 0, 0.3, 0, 0, 0);
-	s.resizeScan(16);
-	for (size_t i = 0; i < 16; i++)
-	{
-		const double a = -s.aperture / 2 + (i + 0.5) * s.aperture / 16;
-		s.setScanRange(i, float(2.8 / std::cos(a)));
-		s.setScanRangeValidity(i, true);
-	}
+	const auto s = leddarWallScan();
 	for (bool keep : {true, false})
 	{
 		CGroundAwareOccupancyGrid g;
@@ -224,12 +220,35 @@ TEST(GroundAwareGrid, LeddarBeamsOverAHoleDoNotClearIt)
 		{
 			EXPECT_DOUBLE_EQ(pOcc(g, 2.2, 0.0), hole);
 			EXPECT_DOUBLE_EQ(pOcc(g, 1.6, 0.7), box);
-			EXPECT_LT(pOcc(g, 1.0, 0.0), floor) << "free floor still gets freer";
+			EXPECT_DOUBLE_EQ(pOcc(g, 1.0, 0.0), floor) << "a planar beam makes no cell freer, not even free floor";
 		}
 		else
 			EXPECT_LT(pOcc(g, 2.2, 0.0), 0.5) << "the plain beam model erases the hole";
 		EXPECT_GT(pOcc(g, 3.0, 0.0), 0.6) << "the wall";
 	}
+}
+
+TEST(GroundAwareGrid, LeddarScansDoNotOutvoteAHoleSeenLater)
+{
+	// Issue #17, first cause. From afar a pit looks like floor (the part of it
+	// the camera sees is shallower than the ground band), so its cells start
+	// free. The Leddar then passes over them 10 times a second. If its beams
+	// could reinforce free cells, 20 scans (2 s) would drive them to the
+	// log-odds clamp and the hole seen later from close by could not mark them.
+	// With no beam freeing, one floor frame (P = 0.5 - K_g = 0.2, log-odds
+	// ln(0.8/0.2) = 1.39 towards free) is outvoted by two hole frames (P up to
+	// 0.5 + 0.5 K_m = 0.9 each, 2 x ln(0.9/0.1) = 4.39 towards occupied).
+	CGroundAwareOccupancyGrid g;
+	g.insertObservation(*testscene::renderDepth(testscene::floorWithHole(-1, 6, -3, 3), kKinect));
+	const double seenAsFloor = pOcc(g, 2.2, 0.0);
+	ASSERT_LT(seenAsFloor, 0.4);
+	const auto s = leddarWallScan();
+	for (int k = 0; k < 20; k++) g.insertObservation(s);
+	EXPECT_DOUBLE_EQ(pOcc(g, 2.2, 0.0), seenAsFloor) << "the Leddar passed over the cell: no evidence about the floor";
+	const auto hole = testscene::renderDepth(holeAndBoxScene(), kKinect);
+	for (int k = 0; k < 2; k++) g.insertObservation(*hole);
+	EXPECT_GT(pOcc(g, 2.2, 0.0), 0.5) << "the hole seen from close by wins";
+	EXPECT_GT(pOcc(g, 3.0, 0.0), 0.6) << "the Leddar's own hits still count";
 }
 
 TEST(GroundAwareGrid, MalformedObservationsThrowClearErrors)

@@ -97,6 +97,15 @@ VoxelClass InverseSensorModel::classify(
 	if (dTop > th) return VoxelClass::Obstacle;
 	// Top within the band; a bottom far below it is the edge of a hole.
 	if (dBot < -th) return VoxelClass::Drop;
+	// Every sample is inside the band, but their mean may not be: the noise
+	// part of the band shrinks with sqrt(N) for the mean of N samples, the
+	// d_pth part (plane error, floor unevenness) does not.
+	if (m_params.mean_test && c.count > 1 && th > m_params.d_pth)
+	{
+		const double meanBand = m_params.d_pth + (th - m_params.d_pth) / std::sqrt(double(c.count));
+		if (dMean > meanBand) return VoxelClass::Obstacle;
+		if (dMean < -meanBand) return VoxelClass::Drop;
+	}
 	return VoxelClass::Ground;
 }
 

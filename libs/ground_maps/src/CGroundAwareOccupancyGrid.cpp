@@ -180,8 +180,11 @@ bool CGroundAwareOccupancyGrid::insert2D(
 
 	// A planar beam sees only its own height: passing over a hole, a cable or
 	// a 5 cm box says nothing about the floor. So the beam model adds its hits
-	// and may reinforce cells already known free, but may not make an unknown
-	// or occupied cell any freer: only seen floor is free.
+	// but makes no cell freer: only floor the depth camera saw is free. (It
+	// used to reinforce cells already free; at 10 Hz with upsampled rays that
+	// drove cells seen as floor from afar -- where a pit's visible part is
+	// shallower than the ground band -- to the log-odds clamp, and the drop
+	// seen later from close by could no longer mark them: issue #17.)
 	const std::vector<cellType> before = m_map;
 	const float x0 = getXMin(), y0 = getYMin();
 	const int sx0 = int(getSizeX()), sy0 = int(getSizeY());
@@ -194,7 +197,6 @@ bool CGroundAwareOccupancyGrid::insert2D(
 		for (int cx = 0; cx < sx0; cx++)
 		{
 			const cellType old = before[size_t(cy) * size_t(sx0) + size_t(cx)];
-			if (old > 0) continue;  // free before: any update is fine
 			const int nx = cx + ox, ny = cy + oy;
 			if (nx < 0 || ny < 0 || nx >= sx || ny >= sy) continue;
 			cellType& now = m_map[size_t(ny) * size_t(sx) + size_t(nx)];

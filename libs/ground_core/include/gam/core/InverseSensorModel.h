@@ -40,6 +40,13 @@ struct IsmParams
 	bool measure_floor_noise = true;
 	int floor_noise_min_cells = 10;
 	double floor_noise_bin = 0.5;  ///< range bin of the measured floor noise [m]
+	/** Judge a voxel by the mean of its N samples too: the band above is for
+	 * one sample; the mean of N has sigma / sqrt(N), so its band is
+	 * d_pth + noise_sigmas * sigma / sqrt(N). A 4 cm cable or a 5 cm pit
+	 * bottom 4 m away lies inside the one-sample band (the floor scatter there
+	 * is ~8 mm) but its 20 samples put the mean far outside the band of the
+	 * mean (issue #17). Off = only z_min / z_max against the one-sample band. */
+	bool mean_test = true;
 	/** Obstacle and drop voxels with fewer samples give no evidence. Any real
 	 * surface within a depth camera's range fills a d_r cell with several
 	 * samples (a 5 cm cell of floor 4.5 m away from a 512x424 Kinect One
@@ -76,6 +83,9 @@ struct IsmParams
 		visit(
 			ParamInfo{"noise_sigmas", 0, 10, "ground band = d_pth + noise_sigmas * vertical noise; 0 = fixed d_pth"},
 			p.noise_sigmas);
+		visit(
+			ParamInfo{"mean_test", 0, 1, "also judge a voxel by its mean against the band of the mean (sigma/sqrt(N))"},
+			p.mean_test);
 		visit(
 			ParamInfo{
 				"min_obstacle_points", 1, 1000000,
@@ -172,7 +182,10 @@ class InverseSensorModel
 	/** Class of each observed frame cell (None elsewhere). */
 	const std::vector<VoxelClass>& classes() const { return m_class; }
 
-	/** Classification of one voxel against one plane (exposed for tests). */
+	/** Classification of one voxel against one plane (exposed for tests).
+	 * `band` is the one-sample ground band (groundBand()): a voxel whose top or
+	 * bottom leaves it is an obstacle or a drop; with mean_test, so is one
+	 * whose mean leaves d_pth + (band - d_pth) / sqrt(N). */
 	VoxelClass classify(const ElevationCell& c, double x, double y, const Plane& pl, double band, double& dMean) const;
 	/** Half-width of the ground band for a voxel at (x, y, z) seen from `sensor`
 	 * (h: sensor height over the plane): d_pth + noise_sigmas * the floor's
