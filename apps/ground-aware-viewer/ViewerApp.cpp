@@ -294,6 +294,13 @@ class ViewerFrame : public wxFrame
 			wxPGProperty* p = nullptr;
 			if constexpr (std::is_same_v<T, bool>)
 				p = new wxBoolProperty(name, name, v);
+			else if constexpr (std::is_enum_v<T>)
+			{
+				// A choice (ism_model, rrt_variant): a drop-down of its names.
+				wxArrayString labels;
+				for (int i = 0; info.choices && info.choices[i]; i++) labels.Add(info.choices[i]);
+				p = new wxEnumProperty(name, name, labels, wxArrayInt(), int(v));
+			}
 			else if constexpr (std::is_integral_v<T>)
 				p = new wxIntProperty(name, name, long(v));
 			else
@@ -316,6 +323,8 @@ class ViewerFrame : public wxFrame
 			if (key != info.key) return;
 			if constexpr (std::is_same_v<T, bool>)
 				v = value.GetBool();
+			else if constexpr (std::is_enum_v<T>)
+				v = T(int(value.GetLong()));
 			else if constexpr (std::is_integral_v<T>)
 				v = T(value.GetLong());
 			else

@@ -36,7 +36,9 @@ ProjectionFilter PipelineParams::projectionFilter(double robotZ) const
 	// Points above the robot can never block it; dropping them here keeps a
 	// beam or a door frame from merging with the floor below it into one tall
 	// 2.5D column (a cell keeps only z-min and z-max).
-	f.z_max = float(robotZ + std::min<double>(projection.z_max, ism.robot_height));
+	// (Not in the paper's model, which keeps everything the projection band holds.)
+	const bool crop = ism.model != MethodVariant::Paper;
+	f.z_max = float(robotZ + (crop ? std::min<double>(projection.z_max, ism.robot_height) : projection.z_max));
 	return f;
 }
 

@@ -22,6 +22,26 @@ double obstacleProbability(double pr, const IsmParams& p) { return 0.5 + 0.5 * p
 double groundProbability(double d, const IsmParams& p) { return 0.5 - p.K_g * std::exp(-d * d / (2.0 * p.sigma2)); }
 }  // namespace ism
 
+namespace paper
+{
+double voxelVolume(double span, double resolution) { return resolution * resolution * std::max(span, resolution); }
+double densityConfidence(uint32_t count, double span, const IsmParams& p, double resolution)
+{
+	return p.K_m / (1.0 + std::exp(-p.K_n * (double(count) - p.d_min) / voxelVolume(span, resolution)));
+}
+double obstacleRay(double cDist, double cvDist, double pRho, const IsmParams& p)
+{
+	if (cDist > cvDist) return 0.5;  // eq. (6): behind the voxel, no evidence
+	const double d = cDist - cvDist;
+	return std::max(pRho, 0.5) * std::exp(-d * d / (2.0 * p.sigma2));
+}
+double groundRay(double cDist, double cvDist, const IsmParams& p)
+{
+	if (cDist > cvDist) return 0.5;
+	return p.K_g + (0.5 - p.K_g) / (1.0 + std::exp(-(cDist - cvDist)));
+}
+}  // namespace paper
+
 double InverseSensorModel::groundBand(const Eigen::Vector3d& sensor, double h, double x, double y, double z) const
 {
 	if (m_params.noise_sigmas <= 0) return m_params.d_pth;
@@ -195,6 +215,11 @@ void InverseSensorModel::compute(
 	m_dropVoxels.clear();
 	if (!det.ok() || det.planes.empty()) return;
 	stats.applied = true;
+	if (m_params.model == MethodVariant::Paper)
+	{
+		computePaper(frame, det, sensor, stats);
+		return;
+	}
 
 	buildSupport(g, det);
 	measureFloorNoise(frame, det, sensor);
@@ -297,6 +322,71 @@ void InverseSensorModel::compute(
 			if (qc == VoxelClass::Ground || qc == VoxelClass::Overhead) continue;
 			if (m_evidence[size_t(q)] <= 0.5f) stats.drop_ray_cells++;
 			put(uint32_t(q), p);
+		}
+	}
+}
+
+void InverseSensorModel::computePaper(
+	const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, IsmStats& stats)
+{
+	// The paper's ray model: every voxel c_v of the 2.5D map gives evidence to
+	// the 2D cells on its ray from the sensor, eq. (5) up to |c_v| and none
+	// behind it (eq. (6), our reading). One plane (the RANSAC ground), the fixed
+	// band d_pth, eq. (4) for the density; several voxels on one cell in one
+	// frame combine as in the default model (the largest occupied evidence,
+	// else the strongest free one), one update per cell and frame.
+	const GridGeometry& g = frame.geometry();
+	const Plane& pl = det.planes.front();
+	const double res = g.resolution;
+	const double maxR2 = m_maxRange * m_maxRange;
+	// Eq. (5) as a function of k = (|c_v| - |c|) / d_r, the ray being walked
+	// back from the voxel one cell length at a time: no exp() per cell.
+	const size_t kmax = size_t(std::ceil(m_maxRange / res)) + 2;
+	m_lutGround.resize(kmax);
+	m_lutGauss.resize(kmax);
+	for (size_t k = 0; k < kmax; k++)
+	{
+		const double back = double(k) * res;
+		m_lutGround[k] = float(paper::groundRay(-back, 0.0, m_params));
+		m_lutGauss[k] = float(std::exp(-back * back / (2.0 * m_params.sigma2)));
+	}
+	for (uint32_t idx : frame.observedCells())
+	{
+		const ElevationCell& c = frame.cell(idx);
+		const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
+		const double x = g.cx(cx), y = g.cy(cy);
+		const double dx = x - sensor.x(), dy = y - sensor.y();
+		const double r2 = dx * dx + dy * dy;
+		m_classCells.push_back(idx);
+		if (r2 > maxR2)
+		{
+			m_class[idx] = VoxelClass::OutOfRange;
+			stats.out_of_range++;
+			continue;
+		}
+		const double dTop = pl.signedDistance(x, y, c.z_max), dBot = pl.signedDistance(x, y, c.z_min);
+		const bool ground = std::abs(dTop) <= m_params.d_pth && std::abs(dBot) <= m_params.d_pth;
+		// The paper has ground and obstacle only; a voxel below the plane is
+		// an obstacle voxel (its class says Drop for the viewer and the stats).
+		const VoxelClass cls =
+			ground ? VoxelClass::Ground : (dTop < -m_params.d_pth ? VoxelClass::Drop : VoxelClass::Obstacle);
+		m_class[idx] = cls;
+		(cls == VoxelClass::Ground ? stats.ground : cls == VoxelClass::Drop ? stats.drop : stats.obstacle)++;
+		const float peak =
+			ground ? 1.f : float(std::max(0.5, paper::densityConfidence(c.count, c.span(), m_params, res)));
+		const double len = std::sqrt(r2);
+		const double ux = len > 0 ? dx / len : 0, uy = len > 0 ? dy / len : 0;
+		const size_t steps = std::min(kmax - 1, size_t(len / res));
+		int last = -1;
+		for (size_t k = 0; k <= steps; k++)
+		{
+			const double px = x - ux * (double(k) * res), py = y - uy * (double(k) * res);
+			const int qx = int(std::floor((px - g.x_min) / res)), qy = int(std::floor((py - g.y_min) / res));
+			if (!g.inside(qx, qy)) continue;
+			const int q = int(g.index(qx, qy));
+			if (q == last) continue;
+			last = q;
+			put(uint32_t(q), ground ? m_lutGround[k] : peak * m_lutGauss[k]);
 		}
 	}
 }

@@ -147,7 +147,10 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 			}
 			break;
 		}
-		growTree(grid, seed, out);
+		if (m_params.variant == MethodVariant::Paper)
+			growTreePaper(grid, seed, out);
+		else
+			growTree(grid, seed, out);
 		if (out.nodes.size() >= m_params.min_nodes) break;
 		// The seed was a small flat patch (a box top, a shelf board): exclude
 		// the area the tree covered and try the next candidate.
@@ -193,6 +196,7 @@ void RrtGroundDetector::reserveScratch(const GridGeometry& g)
 	m_ransacInliers.reserve(maxNodes);
 	m_ransac.inliers.reserve(maxNodes);
 	m_fitPts.reserve(size_t(m_params.neighbourhood_x) * size_t(m_params.neighbourhood_y));
+	m_candidates.reserve(maxNodes);
 	if (m_hasNode.size() != g.cellCount())
 	{
 		m_hasNode.assign(g.cellCount(), 0);
@@ -367,6 +371,115 @@ void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& se
 	}
 }
 
+bool RrtGroundDetector::paperAccepts(const GroundNode& parent, double px, double py, float z, const Plane& pl) const
+{
+	// E_th: the new node's height against the parent's local plane there.
+	if (std::abs(double(z) - parent.local.heightAt(px, py)) > m_params.elevation_threshold) return false;
+	// N_th: the paper compares the new local normal with the parent's. As
+	// printed (n_new . n_near <= N_th) it would accept only normals nearly
+	// perpendicular to the parent's; we read it as the sine of the angle
+	// between them, |n_new x n_near| <= N_th (0.2 = 11.5 deg, the same angle
+	// the default variant allows against the vertical).
+	const Eigen::Vector3d a(pl.a, pl.b, pl.c), b(parent.local.a, parent.local.b, parent.local.c);
+	return a.cross(b).norm() <= m_params.normal_threshold * a.norm() * b.norm();
+}
+
+void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out)
+{
+	// Algorithm 1 as printed (our reading where it is ambiguous, see
+	// doc/paper-vs-implementation.md):
+	//  - q uniform in a search window centred on the centroid of the explored
+	//    nodes (it drifts toward them), half side = the nodes' largest offset
+	//    from the centroid along the axis + window_margin;
+	//  - x_new = x_near + d_n (q - x_near) / |q - x_near|: always a d_n step;
+	//  - x_new joins as a child of x_near if it passes E_th and N_th against
+	//    x_near's local plane; else (lines 17-22) as a child of the first
+	//    other node within d_n of it, nearest first, against which it passes.
+	const GridGeometry& g = grid.geometry();
+	out.nodes.clear();
+	out.iterations = 0;
+	for (uint32_t c : m_nodeCells) m_hasNode[c] = 0;
+	m_nodeCells.clear();
+	nodeIndexReset(g);
+	out.nodes.reserve(maxTreeNodes(g));
+	auto add = [&](const GroundNode& n, int cx, int cy) {
+		const uint32_t c = uint32_t(g.index(cx, cy));
+		m_hasNode[c] = 1;
+		m_nodeCells.push_back(c);
+		out.nodes.push_back(n);
+		nodeIndexAdd(uint32_t(out.nodes.size() - 1), cx, cy);
+	};
+	add(seed, g.ix(seed.x), g.iy(seed.y));
+	double sumX = seed.x, sumY = seed.y;
+	double bx0 = seed.x, bx1 = seed.x, by0 = seed.y, by1 = seed.y;
+	std::uniform_real_distribution<double> U(0.0, 1.0);
+	const double dn = m_params.expansion_distance, margin = m_params.window_margin;
+	const float dn2 = float(dn * dn);
+
+	for (int k = 0; k < m_params.iterations; k++)
+	{
+		out.iterations = k + 1;
+		const double n = double(out.nodes.size());
+		const double mx = sumX / n, my = sumY / n;
+		const double hx = std::max(mx - bx0, bx1 - mx) + margin, hy = std::max(my - by0, by1 - my) + margin;
+		const double wx0 = std::max(g.x_min, mx - hx), wx1 = std::min(g.x_max(), mx + hx);
+		const double wy0 = std::max(g.y_min, my - hy), wy1 = std::min(g.y_max(), my + hy);
+		const double qx = wx0 + U(m_rng) * (wx1 - wx0), qy = wy0 + U(m_rng) * (wy1 - wy0);
+
+		float nearD2 = 0;
+		const uint32_t nearIdx = nodeIndexNearest(out.nodes, float(qx), float(qy), nearD2);
+		const double dist = std::sqrt(double(nearD2));
+		if (dist < 1e-9) continue;
+		const GroundNode near = out.nodes[nearIdx];
+		const double nx_ = near.x + (qx - near.x) * (dn / dist), ny_ = near.y + (qy - near.y) * (dn / dist);
+		const int cx = g.ix(nx_), cy = g.iy(ny_);
+		if (!g.inside(cx, cy)) continue;
+		if (m_hasNode[g.index(cx, cy)]) continue;
+		float z;
+		if (!cellHeight(grid, cx, cy, z)) continue;
+		Plane pl;
+		double rms;
+		if (!fitLocalPlane(grid, cx, cy, pl, rms)) continue;
+		const double px = g.cx(cx), py = g.cy(cy);
+		int parent = -1;
+		if (paperAccepts(near, px, py, z, pl))
+			parent = int(nearIdx);
+		else
+		{
+			// Lines 17-22: the other nodes within d_n of x_new, nearest first.
+			m_candidates.clear();
+			for (uint32_t i = 0; i < out.nodes.size(); i++)
+			{
+				if (i == nearIdx) continue;
+				const float ex = float(px) - out.nodes[i].x, ey = float(py) - out.nodes[i].y;
+				const float d2 = ex * ex + ey * ey;
+				if (d2 <= dn2) m_candidates.emplace_back(d2, i);
+			}
+			std::sort(m_candidates.begin(), m_candidates.end());
+			for (const auto& [d2, i] : m_candidates)
+				if (paperAccepts(out.nodes[i], px, py, z, pl))
+				{
+					parent = int(i);
+					break;
+				}
+		}
+		if (parent < 0) continue;
+		GroundNode node;
+		node.x = float(px);
+		node.y = float(py);
+		node.z = float(pl.heightAt(px, py));
+		node.local = pl;
+		node.parent = parent;
+		add(node, cx, cy);
+		sumX += px;
+		sumY += py;
+		bx0 = std::min(bx0, px);
+		bx1 = std::max(bx1, px);
+		by0 = std::min(by0, py);
+		by1 = std::max(by1, py);
+	}
+}
+
 void RrtGroundDetector::fitPlanes(GroundDetection& out)
 {
 	// RANSAC over the node centres gives the ground plane; further RANSAC rounds
@@ -392,7 +505,9 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		remaining.swap(m_rest);
 	};
 
-	for (int k = 0; k < m_params.max_planes && remaining.size() >= 3; k++)
+	// The paper fits one plane: the ground.
+	const int maxPlanes = m_params.variant == MethodVariant::Paper ? 1 : m_params.max_planes;
+	for (int k = 0; k < maxPlanes && remaining.size() >= 3; k++)
 	{
 		rp.min_inliers = k == 0 ? std::max<size_t>(3, m_params.min_nodes / 2) : m_params.min_nodes_per_extra_plane;
 		if (k > 0 && m_params.min_nodes_per_extra_plane == 0) break;

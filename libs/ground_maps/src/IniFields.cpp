@@ -49,6 +49,17 @@ double parseNumber(const std::string& raw, const ParamInfo& info, const std::str
 	return v;
 }
 
+int parseChoice(const std::string& raw, const ParamInfo& info, const std::string& context)
+{
+	std::string names;
+	for (int i = 0; info.choices && info.choices[i]; i++)
+	{
+		if (gam::iequals(raw, info.choices[i])) return i;
+		names += (i ? " | " : "") + std::string(info.choices[i]);
+	}
+	throw std::invalid_argument(context + " " + info.key + "=" + raw + " is not one of " + names);
+}
+
 void GridExtent::validate() const
 {
 	if (!(min_x < max_x) || !(min_y < max_y)) throw std::invalid_argument("needs min_x < max_x and min_y < max_y");

@@ -18,6 +18,11 @@ namespace gam
 {
 struct IsmParams
 {
+	/** `ground_aware` (default): the model below (each voxel's own cell, the
+	 * noise-aware band, drops, ...). `paper`: eq. (3)-(6) of the paper as we
+	 * read them (see computePaper()): a ray model with Table I values and
+	 * none of this implementation's extensions. */
+	MethodVariant model = MethodVariant::GroundAware;
 	double d_pth = 0.03;   ///< plane distance threshold [m]: |d| <= d_pth is ground
 	double K_g = 0.3;      ///< ground gain: a ground voxel says P(occ) = 0.5 - K_g * G(d)
 	double sigma2 = 0.02;  ///< variance of G(d) = exp(-d^2 / (2 sigma2)) [m^2]
@@ -72,6 +77,11 @@ struct IsmParams
 	template <class Self, class Visit>
 	static void forEachParam(Self& p, Visit&& visit)
 	{
+		visit(
+			ParamInfo{
+				"ism_model", 0, 1, "inverse sensor model: ground_aware | paper (eq. 4-6 as printed)",
+				kMethodVariantNames},
+			p.model);
 		visit(ParamInfo{"d_pth", 1e-6, 10, "plane distance threshold [m]"}, p.d_pth);
 		visit(ParamInfo{"K_g", 0, 0.499, "ground gain"}, p.K_g);
 		visit(ParamInfo{"sigma2", 1e-9, 100, "variance of the ground Gaussian [m^2]"}, p.sigma2);
@@ -126,6 +136,7 @@ double densityConfidence(double rho, const IsmParams& p);
 double obstacleProbability(double densityConfidence, const IsmParams& p);
 /** Eq. (6): P(occ) of a ground voxel at plane distance d. */
 double groundProbability(double d, const IsmParams& p);
+
 /** Combines two pieces of evidence for one cell within a frame: occupied
  * evidence wins (the largest one), otherwise the strongest free one. */
 inline float combine(float a, float b)
@@ -134,6 +145,24 @@ inline float combine(float a, float b)
 	return a < b ? a : b;
 }
 }  // namespace ism
+
+/** The paper's model (ism_model = paper), written as printed:
+ *  eq. (4) P_rho = K_m / (1 + exp(-K_n (N_z - d_min) / V_voxel)), with
+ *          V_voxel = d_r^2 * max(z_max - z_min, d_r) (a one-sample voxel
+ *          would have V = 0: we take it one cell tall);
+ *  eq. (5) for a cell c on the voxel's ray with |c| <= |c_v| (2D distances
+ *          from the sensor): obstacle voxel max(P_rho, 0.5) *
+ *          exp(-(|c| - |c_v|)^2 / (2 sigma^2)); ground voxel
+ *          K_g + (0.5 - K_g) / (1 + exp(-(|c| - |c_v|)));
+ *  eq. (6) for |c| in ]|c_v|, |c_v|^max]: no evidence (0.5) -- see
+ *          doc/paper-vs-implementation.md for this reading. */
+namespace paper
+{
+double voxelVolume(double span, double resolution);
+double densityConfidence(uint32_t count, double span, const IsmParams& p, double resolution);
+double obstacleRay(double cDist, double cvDist, double pRho, const IsmParams& p);
+double groundRay(double cDist, double cvDist, const IsmParams& p);
+}  // namespace paper
 
 enum class VoxelClass : uint8_t
 {
@@ -194,6 +223,9 @@ class InverseSensorModel
 
    private:
 	void put(uint32_t cell, float p);
+	void computePaper(
+		const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, IsmStats& stats);
+	std::vector<float> m_lutGround, m_lutGauss;  ///< eq. (5) per whole cell behind the voxel (paper model)
 	const Plane& choosePlane(const GroundDetection& det, const ElevationCell& c, double x, double y, int block) const;
 	void buildSupport(const GridGeometry& g, const GroundDetection& det);
 	void measureFloorNoise(const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor);

@@ -28,7 +28,26 @@ struct ParamInfo
 	const char* key;
 	double lo, hi;
 	const char* help;
+	/** For a choice (an enum whose values are 0..n-1): the n names, then
+	 * nullptr. The .ini holds the name; lo = 0 and hi = n - 1. */
+	const char* const* choices = nullptr;
 };
+
+/** The name of choice `v` of `info` ("?" when out of range). */
+inline const char* choiceName(const ParamInfo& info, int v)
+{
+	for (int i = 0; info.choices && info.choices[i]; i++)
+		if (i == v) return info.choices[i];
+	return "?";
+}
+
+/** The paper's method as printed, or this implementation's (the default). */
+enum class MethodVariant : int
+{
+	GroundAware = 0,
+	Paper = 1
+};
+inline constexpr const char* kMethodVariantNames[] = {"ground_aware", "paper", nullptr};
 
 /** Throws std::invalid_argument "<context> <key>=<value> is out of range <lo>
  * to <hi> (<help>)" when `value` is outside [lo, hi] or not finite. `shown` is
@@ -40,7 +59,13 @@ void checkParamRange(const ParamInfo& info, double value, const std::string& con
 template <class P>
 void checkParamRanges(const P& p, const std::string& context)
 {
-	P::forEachParam(p, [&](const ParamInfo& info, const auto& v) { checkParamRange(info, double(v), context); });
+	P::forEachParam(p, [&](const ParamInfo& info, const auto& v) {
+		using T = std::decay_t<decltype(v)>;
+		if constexpr (std::is_enum_v<T>)
+			checkParamRange(info, double(int(v)), context);
+		else
+			checkParamRange(info, double(v), context);
+	});
 }
 
 /** Throws std::invalid_argument("<context> <what>") unless `ok`: for rules

@@ -17,6 +17,11 @@ namespace gam
 {
 struct RrtGpdParams
 {
+	/** `ground_aware` (default) or `paper`: Algorithm 1 as printed (see
+	 * growTreePaper()): steps of exactly d_n, the normal compared with the
+	 * parent's, the fallback over the nodes within d_n (lines 17-22), a
+	 * window centred on the centroid of the nodes, one ground plane. */
+	MethodVariant variant = MethodVariant::GroundAware;
 	int iterations = 600;  ///< K
 	/** N_th: a node is ground-like if the horizontal part of its local unit
 	 * normal (the sine of its tilt) is at most this. 0.2 = 11.5 deg. */
@@ -59,6 +64,10 @@ struct RrtGpdParams
 	template <class Self, class Visit>
 	static void forEachParam(Self& p, Visit&& visit)
 	{
+		visit(
+			ParamInfo{
+				"rrt_variant", 0, 1, "RRT-GPD: ground_aware | paper (Algorithm 1 as printed)", kMethodVariantNames},
+			p.variant);
 		visit(ParamInfo{"K", 1, 1000000, "RRT-GPD iterations"}, p.iterations);
 		visit(
 			ParamInfo{"N_th", 1e-6, 1, "max horizontal part of a node's unit normal (sin of tilt)"},
@@ -160,11 +169,17 @@ class RrtGroundDetector
 	/** Local least-squares plane of the s_x * s_y cells around (cx, cy), using
 	 * observed heights and IDW estimates. False if too few cells or degenerate. */
 	bool fitLocalPlane(const ElevationGrid& grid, int cx, int cy, Plane& plane, double& rms) const;
+	/** Paper variant (exposed for tests): may a node at (px, py) of height z
+	 * with local plane `pl` join the tree as a child of `parent`? E_th against
+	 * the parent's local plane, N_th against the parent's normal. */
+	bool paperAccepts(const GroundNode& parent, double px, double py, float z, const Plane& pl) const;
 
    private:
 	bool cellHeight(const ElevationGrid& grid, int cx, int cy, float& z) const;
 	bool findSeed(const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed);
 	void growTree(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
+	void growTreePaper(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
+	std::vector<std::pair<float, uint32_t>> m_candidates;  ///< paper fallback: (distance^2, node)
 	void fitPlanes(GroundDetection& out);
 	void reserveScratch(const GridGeometry& g);
 	size_t maxTreeNodes(const GridGeometry& g) const;

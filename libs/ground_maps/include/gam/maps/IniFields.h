@@ -27,6 +27,9 @@ std::string readRaw(const mrpt::config::CConfigFileBase& src, const std::string&
  * integer", or the range error of checkParamRange. */
 bool parseBool(const std::string& raw, const ParamInfo& info, const std::string& context);
 double parseNumber(const std::string& raw, const ParamInfo& info, const std::string& context, bool integer);
+/** Index of `raw` among info.choices (case-insensitive); throws
+ * std::invalid_argument "<context> key=raw is not one of a | b". */
+int parseChoice(const std::string& raw, const ParamInfo& info, const std::string& context);
 
 /** "in section 'S':", the prefix of every message about a key of S. */
 std::string sectionContext(const std::string& section);
@@ -44,6 +47,8 @@ void load(P& p, const mrpt::config::CConfigFileBase& src, const std::string& sec
 		const std::string raw = readRaw(src, section, info.key);
 		if constexpr (std::is_same_v<T, bool>)
 			value = parseBool(raw, info, ctx);
+		else if constexpr (std::is_enum_v<T>)
+			value = T(parseChoice(raw, info, ctx));
 		else
 			value = T(parseNumber(raw, info, ctx, std::is_integral_v<T>));
 	});
@@ -69,6 +74,8 @@ void save(const P& p, mrpt::config::CConfigFileBase& dst, const std::string& sec
 		using T = std::remove_cv_t<std::remove_reference_t<decltype(value)>>;
 		if constexpr (std::is_same_v<T, bool>)
 			dst.write(section, info.key, std::string(value ? "true" : "false"));
+		else if constexpr (std::is_enum_v<T>)
+			dst.write(section, info.key, std::string(choiceName(info, int(value))));
 		else if constexpr (std::is_floating_point_v<T>)
 			dst.write(section, info.key, double(value));
 		else
@@ -86,6 +93,16 @@ std::vector<std::string> keys()
 	return k;
 }
 
+/** A parameter's value as a double (a choice: its index). */
+template <class T>
+double paramAsDouble(const T& v)
+{
+	if constexpr (std::is_enum_v<T>)
+		return double(int(v));
+	else
+		return double(v);
+}
+
 /** Options in a serialized map: a count, then (key, value as double) pairs,
  * so a file written before an option existed still reads (the option keeps
  * its default) and unknown keys from newer files are skipped. */
@@ -96,7 +113,7 @@ void write(const P& p, mrpt::serialization::CArchive& out)
 	P::forEachParam(p, [&](const ParamInfo&, const auto&) { n++; });
 	out << n;
 	P::forEachParam(
-		p, [&](const ParamInfo& info, const auto& value) { out << std::string(info.key) << double(value); });
+		p, [&](const ParamInfo& info, const auto& value) { out << std::string(info.key) << paramAsDouble(value); });
 }
 
 /** Reads what write() wrote (any P: unknown keys are skipped). Throws
@@ -117,6 +134,8 @@ void read(P& p, mrpt::serialization::CArchive& in, const char* who)
 			if (key != info.key) return;
 			if constexpr (std::is_same_v<T, bool>)
 				value = v != 0;
+			else if constexpr (std::is_enum_v<T>)
+				value = T(int(v));
 			else
 				value = T(v);
 		});

@@ -1,0 +1,214 @@
+// Ground-aware mapping for MRPT
+// The paper's method as printed (ism_model = paper, rrt_variant = paper).
+// Every expected value is worked out by hand from the paper's formulas and its
+// Table I (K_m = 0.8, K_n = 0.0005, d_min = 3, K_g = 0.3, sigma^2 = 0.02,
+// d_pth = 0.03, d_r = 0.05, N_th = 0.2, E_th = 0.05, d_n = 0.4), not from the code.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "gam/core/InverseSensorModel.h"
+#include "gam/core/RrtGroundDetector.h"
+#include "test_helpers.h"
+
+using namespace gam;
+
+namespace
+{
+IsmParams paperIsm()
+{
+	IsmParams p;
+	p.model = MethodVariant::Paper;
+	return p;
+}
+
+GroundDetection floorDetection()
+{
+	GroundDetection d;
+	d.status = GroundDetection::Status::Ok;
+	d.planes.push_back(Plane{0, 0, 1, 0});  // z = 0
+	d.plane_support.push_back(100);
+	return d;
+}
+
+/** The evidence of the frame cell whose centre is nearest (x, y). */
+float evidenceAt(const InverseSensorModel& ism, const ElevationGrid& grid, double x, double y)
+{
+	const GridGeometry& g = grid.geometry();
+	return ism.evidence()[g.index(g.ix(x), g.iy(y))];
+}
+}  // namespace
+
+TEST(PaperIsm, Eq4DensityByHand)
+{
+	const IsmParams p = paperIsm();
+	// V_voxel = d_r^2 * max(span, d_r).
+	EXPECT_DOUBLE_EQ(paper::voxelVolume(0.2, 0.05), 0.0025 * 0.2);  // 5e-4 m^3
+	EXPECT_DOUBLE_EQ(paper::voxelVolume(0.0, 0.05), 0.0025 * 0.05);  // one sample: one cell tall, 1.25e-4
+	// N_z = 20 over 0.2 m: exponent -0.0005 * (20 - 3) / 5e-4 = -17;
+	// P = 0.8 / (1 + e^-17) = 0.8 / 1.0000000414 = 0.79999997.
+	EXPECT_NEAR(paper::densityConfidence(20, 0.2, p, 0.05), 0.79999997, 1e-8);
+	// N_z = 4, flat: -0.0005 * 1 / 1.25e-4 = -4; 0.8 / 1.0183156 = 0.785611.
+	EXPECT_NEAR(paper::densityConfidence(4, 0.0, p, 0.05), 0.785611, 1e-6);
+	// N_z = d_min = 3: exponent 0, P = K_m / 2 = 0.4 (d_min is a sample count).
+	EXPECT_DOUBLE_EQ(paper::densityConfidence(3, 0.0, p, 0.05), 0.4);
+	// N_z = 1: +0.0005 * 2 / 1.25e-4 = +8; 0.8 / (1 + 2980.958) = 2.6829e-4.
+	EXPECT_NEAR(paper::densityConfidence(1, 0.0, p, 0.05), 2.6829e-4, 1e-8);
+}
+
+TEST(PaperIsm, Eq5And6AlongTheRayByHand)
+{
+	const IsmParams p = paperIsm();
+	// Obstacle voxel at |c_v| = 2 m with P_rho = 0.785610 (N_z = 4):
+	// at the voxel max(P_rho, 0.5) = 0.785610;
+	EXPECT_NEAR(paper::obstacleRay(2.0, 2.0, 0.785610, p), 0.785610, 1e-9);
+	// 0.1 m in front: 0.785610 * exp(-0.01 / 0.04) = 0.785610 * 0.7788008 = 0.611834;
+	EXPECT_NEAR(paper::obstacleRay(1.9, 2.0, 0.785610, p), 0.611834, 1e-6);
+	// 0.5 m in front: 0.785610 * exp(-0.25 / 0.04) = 0.785610 * 0.0019305 = 0.0015166: free.
+	EXPECT_NEAR(paper::obstacleRay(1.5, 2.0, 0.785610, p), 0.0015166, 1e-7);
+	// A sparse voxel (P_rho < 0.5) peaks at 0.5 (no evidence of an obstacle)
+	// and still frees the cells in front of it: 0.5 * 0.7788008 = 0.3894004.
+	EXPECT_DOUBLE_EQ(paper::obstacleRay(2.0, 2.0, 2.68e-4, p), 0.5);
+	EXPECT_NEAR(paper::obstacleRay(1.9, 2.0, 2.68e-4, p), 0.3894004, 1e-7);
+	// Ground voxel: K_g + (0.5 - K_g) / (1 + e^-(|c| - |c_v|)):
+	// at the voxel 0.3 + 0.2 / 2 = 0.4;
+	EXPECT_NEAR(paper::groundRay(2.0, 2.0, p), 0.4, 1e-12);
+	// 0.5 m in front: 0.3 + 0.2 / (1 + e^0.5) = 0.3 + 0.2 / 2.6487213 = 0.3755081;
+	EXPECT_NEAR(paper::groundRay(1.5, 2.0, p), 0.3755081, 1e-7);
+	// 1 m in front: 0.3 + 0.2 / (1 + e^1) = 0.3 + 0.2 / 3.7182818 = 0.3537883.
+	EXPECT_NEAR(paper::groundRay(1.0, 2.0, p), 0.3537883, 1e-7);
+	// Eq. (6), behind the voxel (our reading): no evidence.
+	EXPECT_DOUBLE_EQ(paper::groundRay(2.1, 2.0, p), 0.5);
+	EXPECT_DOUBLE_EQ(paper::obstacleRay(2.1, 2.0, 0.785610, p), 0.5);
+}
+
+TEST(PaperIsm, ComputeWalksEachVoxelsRay)
+{
+	// Frame grid 0..5 m x -1..1 m of 5 cm cells; sensor at (0, 0.025, 1), floor z = 0.
+	ElevationGrid grid(gamtest::makeGeometry(0.0, -1.0, 0.05, 100, 40));
+	// A ground voxel (4 samples at z = 0) in the cell centred (2.025, 0.025) and
+	// an obstacle voxel (20 samples, 0 to 0.2 m) in the cell centred (3.525, 0.025):
+	// both on the line y = 0.025 from the sensor, 2.025 m and 3.525 m away.
+	std::vector<std::array<double, 3>> pts;
+	for (int i = 0; i < 4; i++) pts.push_back({2.01 + 0.01 * i, 0.025, 0.0});
+	for (int i = 0; i < 20; i++) pts.push_back({3.525, 0.025, 0.2 * i / 19.0});
+	gamtest::insertPoints(grid, pts);
+	InverseSensorModel ism(paperIsm());
+	IsmStats st;
+	ism.compute(grid, floorDetection(), {0.0, 0.025, 1.0}, 4.5, st);
+	EXPECT_EQ(st.ground, 1u);
+	EXPECT_EQ(st.obstacle, 1u);
+	// Obstacle: P_rho = 0.8 / (1 + e^(-0.0005 * 17 / (0.0025 * 0.2))) = 0.8 (to 3e-8).
+	EXPECT_NEAR(evidenceAt(ism, grid, 3.525, 0.025), 0.8, 1e-6);
+	// 0.1 m in front of it: 0.8 * exp(-0.25) = 0.6230406.
+	EXPECT_NEAR(evidenceAt(ism, grid, 3.425, 0.025), 0.6230406, 1e-6);
+	// The ground voxel's own cell, 1.5 m in front of the obstacle: the obstacle's
+	// ray gives 0.8 * exp(-2.25 / 0.04) ~ 3e-25, the ground voxel 0.4; both are
+	// free evidence, the strongest wins: ~0.
+	EXPECT_LT(evidenceAt(ism, grid, 2.025, 0.025), 1e-6);
+	// Behind the obstacle (eq. 6): nothing.
+	EXPECT_FLOAT_EQ(evidenceAt(ism, grid, 3.625, 0.025), 0.5f);
+	// Only the ground voxel's ray: a second run without the obstacle.
+	ElevationGrid g2(gamtest::makeGeometry(0.0, -1.0, 0.05, 100, 40));
+	pts.resize(4);
+	gamtest::insertPoints(g2, pts);
+	ism.compute(g2, floorDetection(), {0.0, 0.025, 1.0}, 4.5, st);
+	EXPECT_NEAR(evidenceAt(ism, g2, 2.025, 0.025), 0.4, 1e-6);
+	// 1 m (20 cells) in front: 0.3537883; 0.5 m: 0.3755081.
+	EXPECT_NEAR(evidenceAt(ism, g2, 1.025, 0.025), 0.3537883, 1e-6);
+	EXPECT_NEAR(evidenceAt(ism, g2, 1.525, 0.025), 0.3755081, 1e-6);
+	EXPECT_FLOAT_EQ(evidenceAt(ism, g2, 2.525, 0.025), 0.5f);  // behind: nothing
+	// The default model gives evidence to the voxel's own cell only.
+	InverseSensorModel dflt;
+	dflt.compute(g2, floorDetection(), {0.0, 0.025, 1.0}, 4.5, st);
+	EXPECT_FLOAT_EQ(evidenceAt(dflt, g2, 1.025, 0.025), 0.5f);
+}
+
+TEST(PaperRrt, NormalAndElevationTestsAtTheirBoundaries)
+{
+	RrtGpdParams rp;
+	rp.variant = MethodVariant::Paper;
+	RrtGroundDetector rrt(rp);
+	GroundNode parent;
+	parent.local = Plane{0, 0, 1, 0};  // z = 0
+	// E_th = 0.05 against the parent's plane at the new position.
+	EXPECT_TRUE(rrt.paperAccepts(parent, 0.4, 0, 0.0499f, Plane{0, 0, 1, -0.0499}));
+	EXPECT_FALSE(rrt.paperAccepts(parent, 0.4, 0, 0.0501f, Plane{0, 0, 1, -0.0501}));
+	// N_th = 0.2 as sin of the angle between the normals: asin(0.2) = 11.537 deg.
+	auto tilted = [](double deg) {
+		const double t = gamtest::deg2rad(deg);
+		return Plane{-std::sin(t), 0, std::cos(t), 0};
+	};
+	EXPECT_TRUE(rrt.paperAccepts(parent, 0.4, 0, 0.0f, tilted(11.5)));   // sin = 0.19937
+	EXPECT_FALSE(rrt.paperAccepts(parent, 0.4, 0, 0.0f, tilted(11.6)));  // sin = 0.20108
+	// Against the parent's normal, not the vertical: a 20 deg patch joins a
+	// 10 deg parent (sin 10 deg = 0.1736), which the default's vertical test
+	// (sin 20 deg = 0.342 > 0.2) refuses. Parent plane through the origin; the
+	// new node at x = 0.4 on it: z = tan(10 deg) * 0.4 = 0.070530.
+	GroundNode slope;
+	slope.local = tilted(10);
+	const float z = float(std::tan(gamtest::deg2rad(10)) * 0.4);
+	EXPECT_TRUE(rrt.paperAccepts(slope, 0.4, 0, z, tilted(20)));
+	EXPECT_FALSE(rrt.paperAccepts(slope, 0.4, 0, z, tilted(22)));  // sin 12 deg = 0.2079
+}
+
+namespace
+{
+/** A noisy 6 x 6 m floor (3 mm), 5 cm cells, 4 x 4 samples per cell. */
+ElevationGrid noisyFloor(double noise)
+{
+	ElevationGrid grid(gamtest::makeGeometry(-3, -3, 0.05, 120, 120));
+	std::mt19937 rng(7);
+	BinnedPoints b;
+	gamtest::sampleSurface(grid, -3, 3, -3, 3, [](double, double) { return 0.0; }, 4, noise, rng, b);
+	gamtest::insertAll(grid, b);
+	return grid;
+}
+double parentDistance(const GroundDetection& d, const GroundNode& n)
+{
+	const GroundNode& p = d.nodes[size_t(n.parent)];
+	return std::hypot(double(n.x - p.x), double(n.y - p.y));
+}
+}  // namespace
+
+TEST(PaperRrt, StepsOfExactlyDnAndTheFallbackThroughANeighbour)
+{
+	const ElevationGrid grid = noisyFloor(0.003);
+	RrtGpdParams rp;
+	rp.variant = MethodVariant::Paper;
+	// A tight E_th (the 3 mm noise makes a local plane's extrapolation miss it
+	// now and then) so that some new nodes fail against x_near.
+	rp.elevation_threshold = 0.004;
+	RrtGroundDetector rrt(rp);
+	GroundDetection d;
+	rrt.detect(grid, GroundSeedHint{}, d);
+	ASSERT_TRUE(d.ok()) << d.describe();
+	// x_new is exactly d_n = 0.4 m from x_near, then snapped to its cell
+	// centre (parent on a centre too): off by at most half a cell diagonal,
+	// 0.05 * sqrt(2) / 2 = 0.0354 m.
+	const double snap = 0.05 * std::sqrt(2.0) / 2 + 1e-6;
+	size_t viaNear = 0, viaNeighbour = 0;
+	for (size_t i = 1; i < d.nodes.size(); i++)
+	{
+		const double pd = parentDistance(d, d.nodes[i]);
+		EXPECT_LE(pd, 0.4 + snap) << "node " << i;
+		// A parent closer than d_n - snap is not the x_near the step came from:
+		// the node joined through the fallback over the nodes within d_n.
+		(pd >= 0.4 - snap ? viaNear : viaNeighbour)++;
+	}
+	EXPECT_GT(viaNear, 0u);
+	EXPECT_GT(viaNeighbour, 0u) << "no node joined through a neighbour (lines 17-22)";
+	EXPECT_EQ(d.planes.size(), 1u) << "the paper fits one ground plane";
+
+	// The default variant steps min(d_n, distance to q): short steps occur.
+	RrtGpdParams dp;
+	RrtGroundDetector dflt(dp);
+	GroundDetection dd;
+	dflt.detect(grid, GroundSeedHint{}, dd);
+	ASSERT_TRUE(dd.ok());
+	size_t shortSteps = 0;
+	for (size_t i = 1; i < dd.nodes.size(); i++)
+		if (parentDistance(dd, dd.nodes[i]) < 0.4 - snap) shortSteps++;
+	EXPECT_GT(shortSteps, 0u);
+}
