@@ -44,7 +44,7 @@ TEST(PaperIsm, Eq4DensityByHand)
 {
 	const IsmParams p = paperIsm();
 	// V_voxel = d_r^2 * max(span, d_r).
-	EXPECT_DOUBLE_EQ(paper::voxelVolume(0.2, 0.05), 0.0025 * 0.2);  // 5e-4 m^3
+	EXPECT_DOUBLE_EQ(paper::voxelVolume(0.2, 0.05), 0.0025 * 0.2);   // 5e-4 m^3
 	EXPECT_DOUBLE_EQ(paper::voxelVolume(0.0, 0.05), 0.0025 * 0.05);  // one sample: one cell tall, 1.25e-4
 	// N_z = 20 over 0.2 m: exponent -0.0005 * (20 - 3) / 5e-4 = -17;
 	// P = 0.8 / (1 + e^-17) = 0.8 / 1.0000000414 = 0.79999997.
@@ -161,7 +161,8 @@ ElevationGrid noisyFloor(double noise)
 	ElevationGrid grid(gamtest::makeGeometry(-3, -3, 0.05, 120, 120));
 	std::mt19937 rng(7);
 	BinnedPoints b;
-	gamtest::sampleSurface(grid, -3, 3, -3, 3, [](double, double) { return 0.0; }, 4, noise, rng, b);
+	gamtest::sampleSurface(
+		grid, -3, 3, -3, 3, [](double, double) { return 0.0; }, 4, noise, rng, b);
 	gamtest::insertAll(grid, b);
 	return grid;
 }
