@@ -291,9 +291,17 @@ uint32_t RrtGroundDetector::nodeIndexNearest(
 	return uint32_t(best);
 }
 
-void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out)
+void RrtGroundDetector::addTreeNode(const GridGeometry& g, const GroundNode& node, int cx, int cy, GroundDetection& out)
 {
-	const GridGeometry& g = grid.geometry();
+	const uint32_t c = uint32_t(g.index(cx, cy));
+	m_hasNode[c] = 1;
+	m_nodeCells.push_back(c);
+	out.nodes.push_back(node);
+	nodeIndexAdd(uint32_t(out.nodes.size() - 1), cx, cy);
+}
+
+void RrtGroundDetector::startTree(const GridGeometry& g, const GroundNode& seed, GroundDetection& out)
+{
 	out.nodes.clear();
 	out.iterations = 0;
 	for (uint32_t c : m_nodeCells) m_hasNode[c] = 0;
@@ -308,14 +316,13 @@ void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& se
 	// reused between frames (see nodeIndexNearest).
 	nodeIndexReset(g);
 	out.nodes.reserve(maxTreeNodes(g));
-	out.nodes.push_back(seed);
-	{
-		const int sx = g.ix(seed.x), sy = g.iy(seed.y);
-		const uint32_t c = uint32_t(g.index(sx, sy));
-		m_hasNode[c] = 1;
-		m_nodeCells.push_back(c);
-		nodeIndexAdd(0, sx, sy);
-	}
+	addTreeNode(g, seed, g.ix(seed.x), g.iy(seed.y), out);
+}
+
+void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out)
+{
+	const GridGeometry& g = grid.geometry();
+	startTree(g, seed, out);
 
 	// Sampling window: the nodes' bounding box grown by window_margin, clamped
 	// to the grid. It grows and drifts as the tree explores.
@@ -341,8 +348,7 @@ void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& se
 		const double nx_ = near.x + (qx - near.x) * s, ny_ = near.y + (qy - near.y) * s;
 		const int cx = g.ix(nx_), cy = g.iy(ny_);
 		if (!g.inside(cx, cy)) continue;
-		const uint32_t cidx = uint32_t(g.index(cx, cy));
-		if (m_hasNode[cidx]) continue;
+		if (m_hasNode[g.index(cx, cy)]) continue;
 		float z;
 		if (!cellHeight(grid, cx, cy, z)) continue;
 		const double px = g.cx(cx), py = g.cy(cy);
@@ -360,10 +366,7 @@ void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& se
 		node.z = float(pl.heightAt(px, py));
 		node.local = pl;
 		node.parent = int(nearIdx);
-		out.nodes.push_back(node);
-		m_hasNode[cidx] = 1;
-		m_nodeCells.push_back(cidx);
-		nodeIndexAdd(uint32_t(out.nodes.size() - 1), cx, cy);
+		addTreeNode(g, node, cx, cy, out);
 		bx0 = std::min(bx0, px);
 		bx1 = std::max(bx1, px);
 		by0 = std::min(by0, py);
@@ -396,20 +399,7 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 	//    x_near's local plane; else (lines 17-22) as a child of the first
 	//    other node within d_n of it, nearest first, against which it passes.
 	const GridGeometry& g = grid.geometry();
-	out.nodes.clear();
-	out.iterations = 0;
-	for (uint32_t c : m_nodeCells) m_hasNode[c] = 0;
-	m_nodeCells.clear();
-	nodeIndexReset(g);
-	out.nodes.reserve(maxTreeNodes(g));
-	auto add = [&](const GroundNode& n, int cx, int cy) {
-		const uint32_t c = uint32_t(g.index(cx, cy));
-		m_hasNode[c] = 1;
-		m_nodeCells.push_back(c);
-		out.nodes.push_back(n);
-		nodeIndexAdd(uint32_t(out.nodes.size() - 1), cx, cy);
-	};
-	add(seed, g.ix(seed.x), g.iy(seed.y));
+	startTree(g, seed, out);
 	double sumX = seed.x, sumY = seed.y;
 	double bx0 = seed.x, bx1 = seed.x, by0 = seed.y, by1 = seed.y;
 	std::uniform_real_distribution<double> U(0.0, 1.0);
@@ -470,7 +460,7 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 		node.z = float(pl.heightAt(px, py));
 		node.local = pl;
 		node.parent = parent;
-		add(node, cx, cy);
+		addTreeNode(g, node, cx, cy, out);
 		sumX += px;
 		sumY += py;
 		bx0 = std::min(bx0, px);

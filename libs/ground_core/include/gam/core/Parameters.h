@@ -55,17 +55,21 @@ inline constexpr const char* kMethodVariantNames[] = {"ground_aware", "paper", n
  * brackets: MRPT's exception wrapper parses them and would split the message. */
 void checkParamRange(const ParamInfo& info, double value, const std::string& context, const std::string& shown = {});
 
+/** A parameter's value as a double (a choice: its index). */
+template <class T>
+double paramAsDouble(const T& v)
+{
+	if constexpr (std::is_enum_v<T>)
+		return double(int(v));
+	else
+		return double(v);
+}
+
 /** Range check of every parameter of `p` (a struct with forEachParam). */
 template <class P>
 void checkParamRanges(const P& p, const std::string& context)
 {
-	P::forEachParam(p, [&](const ParamInfo& info, const auto& v) {
-		using T = std::decay_t<decltype(v)>;
-		if constexpr (std::is_enum_v<T>)
-			checkParamRange(info, double(int(v)), context);
-		else
-			checkParamRange(info, double(v), context);
-	});
+	P::forEachParam(p, [&](const ParamInfo& info, const auto& v) { checkParamRange(info, paramAsDouble(v), context); });
 }
 
 /** Throws std::invalid_argument("<context> <what>") unless `ok`: for rules

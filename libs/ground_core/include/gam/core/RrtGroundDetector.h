@@ -177,6 +177,10 @@ class RrtGroundDetector
    private:
 	bool cellHeight(const ElevationGrid& grid, int cx, int cy, float& z) const;
 	bool findSeed(const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed);
+	/** Empties the tree (and its node index) and plants `seed`: both variants. */
+	void startTree(const GridGeometry& g, const GroundNode& seed, GroundDetection& out);
+	/** Appends `node` (in cell (cx, cy)) to the tree and its index. */
+	void addTreeNode(const GridGeometry& g, const GroundNode& node, int cx, int cy, GroundDetection& out);
 	void growTree(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
 	void growTreePaper(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
 	std::vector<std::pair<float, uint32_t>> m_candidates;  ///< paper fallback: (distance^2, node)

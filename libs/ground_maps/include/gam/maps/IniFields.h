@@ -93,16 +93,6 @@ std::vector<std::string> keys()
 	return k;
 }
 
-/** A parameter's value as a double (a choice: its index). */
-template <class T>
-double paramAsDouble(const T& v)
-{
-	if constexpr (std::is_enum_v<T>)
-		return double(int(v));
-	else
-		return double(v);
-}
-
 /** Options in a serialized map: a count, then (key, value as double) pairs,
  * so a file written before an option existed still reads (the option keeps
  * its default) and unknown keys from newer files are skipped. */

@@ -62,8 +62,8 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		// 2D scans
 		int sparse_scan_upsampling = 8;  ///< rays per beam for scans of < 64 beams (Leddar)
 		/** A planar beam passes over holes, cables and small boxes: with this
-		 * on, 2D scans add their hits and reinforce cells already free, but
-		 * never make an unknown or occupied cell freer (only seen floor is free). */
+		 * on, 2D scans add their hits and make no cell freer: only floor the
+		 * depth camera saw is free (off: MRPT's beam model). */
 		bool scan_keeps_3d_obstacles = true;
 
 		/** Every `_groundOpts` key: the pipeline's, then the 2D-scan ones. */
@@ -75,7 +75,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 				gam::ParamInfo{"sparse_scan_upsampling", 1, 1000, "rays per beam for scans with < 64 beams"},
 				o.sparse_scan_upsampling);
 			visit(
-				gam::ParamInfo{"scan_keeps_3d_obstacles", 0, 1, "2D scans free only cells already free (seen floor)"},
+				gam::ParamInfo{"scan_keeps_3d_obstacles", 0, 1, "2D scans add their hits and free no cell"},
 				o.scan_keeps_3d_obstacles);
 		}
 		/** Loads and validates (throws std::invalid_argument naming the key). */
