@@ -105,8 +105,11 @@ TEST(PaperIsm, ComputeWalksEachVoxelsRay)
 	EXPECT_NEAR(evidenceAt(ism, grid, 3.425, 0.025), 0.6230406, 1e-6);
 	// The ground voxel's own cell, 1.5 m in front of the obstacle: the obstacle's
 	// ray gives 0.8 * exp(-2.25 / 0.04) ~ 3e-25, the ground voxel 0.4; both are
-	// free evidence, the strongest wins: ~0.
-	EXPECT_LT(evidenceAt(ism, grid, 2.025, 0.025), 1e-6);
+	// free evidence, the strongest wins: ~0, i.e. the floor of 0.001 that the
+	// grid clamps every update to.
+	EXPECT_FLOAT_EQ(evidenceAt(ism, grid, 2.025, 0.025), ism::kEvidenceFloor);
+	// 0.4 m in front of the obstacle: 0.8 * exp(-0.16 / 0.04) = 0.8 * 0.0183156 = 0.0146525.
+	EXPECT_NEAR(evidenceAt(ism, grid, 3.125, 0.025), 0.0146525, 1e-6);
 	// Behind the obstacle (eq. 6): nothing.
 	EXPECT_FLOAT_EQ(evidenceAt(ism, grid, 3.625, 0.025), 0.5f);
 	// Only the ground voxel's ray: a second run without the obstacle.
@@ -123,6 +126,98 @@ TEST(PaperIsm, ComputeWalksEachVoxelsRay)
 	InverseSensorModel dflt;
 	dflt.compute(g2, floorDetection(), {0.0, 0.025, 1.0}, 4.5, st);
 	EXPECT_FLOAT_EQ(evidenceAt(dflt, g2, 1.025, 0.025), 0.5f);
+}
+
+TEST(PaperIsm, RayFanByHand)
+{
+	// d_r = 0.05 m, range 4.5 m: 4 pi * 4.5 / 0.05 = 1130.97 -> 1131 bins of
+	// 2 pi / 1131 = 0.00555542 rad; at 4.5 m neighbouring rays are
+	// 4.5 * 0.00555542 = 0.0250 m apart, half a cell.
+	const paper::RayFan fan(0.05, 4.5);
+	EXPECT_EQ(fan.bins, 1131);
+	EXPECT_NEAR(fan.dtheta, 0.00555542, 1e-8);
+	EXPECT_EQ(fan.binOf(1.0, 0.0), 0);
+	EXPECT_EQ(fan.binOf(0.0, 1.0), 283);   // pi/2 / 0.00555542 = 282.75 -> 283
+	EXPECT_EQ(fan.binOf(0.0, -1.0), 848);  // -282.75 -> -283, + 1131
+	// atan2(-0.5, -1) = -(pi - atan(0.5)) = -2.677945; / 0.00555542 = -482.04
+	// -> -482, + 1131 = 649.
+	EXPECT_EQ(fan.binOf(-1.0, -0.5), 649);
+	// Samples at r_k = (k + 1/2) d_r; a voxel 3.525 m away reaches k <= 70
+	// (r_70 = 3.525), one 0.02 m away reaches none.
+	EXPECT_EQ(fan.lastSample(3.525), 70);
+	EXPECT_DOUBLE_EQ(fan.radius(70), 3.525);
+	EXPECT_EQ(fan.lastSample(3.5249), 69);
+	EXPECT_EQ(fan.lastSample(0.02), -1);
+}
+
+TEST(PaperIsm, SweepingEachRayOnceEqualsWalkingEveryVoxelsRay)
+{
+	// compute() sweeps each ray bin once from far to near, keeping only the
+	// farthest ground voxel and the obstacle voxels whose evidence has not
+	// yet fallen to the grid's floor. Reference: every in-range voxel walks
+	// its own ray sample by sample with eq. (5), clamped to the floor, and
+	// the values combine per cell. Both must agree on every cell.
+	const GridGeometry g = gamtest::makeGeometry(-1.0, -3.0, 0.05, 120, 120);
+	const Eigen::Vector3d sensor(-0.73, 0.11, 0.8);
+	const double range = 4.5;
+	const paper::RayFan fan(g.resolution, range);
+	std::mt19937 rng(7);
+	std::uniform_real_distribution<double> ux(-1.0, 5.0), uy(-3.0, 3.0), noise(-0.01, 0.01), u01(0, 1);
+	for (int round = 0; round < 3; round++)
+	{
+		ElevationGrid grid(g);
+		std::vector<std::array<double, 3>> pts;
+		for (int i = 0; i < 30000; i++)
+		{
+			const double x = ux(rng), y = uy(rng);
+			// Floor, with 15 % of the samples on objects or in pits.
+			const double kind = u01(rng);
+			const double z = kind < 0.85 ? noise(rng) : kind < 0.95 ? 0.3 * u01(rng) : -0.2 * u01(rng);
+			pts.push_back({x, y, z});
+		}
+		gamtest::insertPoints(grid, pts);
+		const IsmParams p = paperIsm();
+		InverseSensorModel ism(p);
+		IsmStats st;
+		ism.compute(grid, floorDetection(), sensor, range, st);
+		ASSERT_GT(st.ground, 1000u);
+		ASSERT_GT(st.obstacle + st.drop, 300u);
+
+		std::vector<float> ref(g.cellCount(), 0.5f);
+		auto add = [&](int qx, int qy, double v) {
+			if (!g.inside(qx, qy)) return;
+			float& e = ref[g.index(qx, qy)];
+			e = ism::combine(e, std::max(float(v), ism::kEvidenceFloor));
+		};
+		for (uint32_t idx : grid.observedCells())
+		{
+			const VoxelClass cls = ism.classes()[idx];
+			if (cls != VoxelClass::Ground && cls != VoxelClass::Obstacle && cls != VoxelClass::Drop) continue;
+			const ElevationCell& c = grid.cell(idx);
+			const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
+			const double dx = g.cx(cx) - sensor.x(), dy = g.cy(cy) - sensor.y();
+			const double cv = std::hypot(dx, dy);
+			const double rho = paper::densityConfidence(c.count, c.span(), p, g.resolution);
+			auto value = [&](double cd) {
+				return cls == VoxelClass::Ground ? paper::groundRay(cd, cv, p) : paper::obstacleRay(cd, cv, rho, p);
+			};
+			add(cx, cy, value(cv));
+			const double a = fan.angle(fan.binOf(dx, dy));
+			for (int k = fan.lastSample(cv); k >= 0; k--)
+			{
+				const double r = fan.radius(k);
+				add(g.ix(sensor.x() + r * std::cos(a)), g.iy(sensor.y() + r * std::sin(a)), value(r));
+			}
+		}
+		size_t differ = 0, withEvidence = 0;
+		for (size_t i = 0; i < ref.size(); i++)
+		{
+			differ += std::abs(ref[i] - ism.evidence()[i]) > 1e-6f;
+			withEvidence += ref[i] != 0.5f;
+		}
+		EXPECT_EQ(differ, 0u) << "round " << round;
+		EXPECT_GT(withEvidence, 5000u);
+	}
 }
 
 TEST(PaperRrt, NormalAndElevationTestsAtTheirBoundaries)

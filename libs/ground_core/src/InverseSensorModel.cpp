@@ -339,23 +339,19 @@ void InverseSensorModel::computePaper(
 	const Plane& pl = det.planes.front();
 	const double res = g.resolution;
 	const double maxR2 = m_maxRange * m_maxRange;
-	// Eq. (5) as a function of k = (|c_v| - |c|) / d_r, the ray being walked
-	// back from the voxel one cell length at a time: no exp() per cell.
-	const size_t kmax = size_t(std::ceil(m_maxRange / res)) + 2;
-	m_lutGround.resize(kmax);
-	m_lutGauss.resize(kmax);
-	for (size_t k = 0; k < kmax; k++)
-	{
-		const double back = double(k) * res;
-		m_lutGround[k] = float(paper::groundRay(-back, 0.0, m_params));
-		m_lutGauss[k] = float(std::exp(-back * back / (2.0 * m_params.sigma2)));
-	}
+	const double sx = sensor.x(), sy = sensor.y();
+	const paper::RayFan fan(res, m_maxRange);
+	const float floorP = ism::kEvidenceFloor;
+
+	// 1. Classify every voxel in range (ground: both ends within d_pth); its
+	// own cell gets eq. (5) at |c| = |c_v|.
+	m_paperVoxels.clear();
 	for (uint32_t idx : frame.observedCells())
 	{
 		const ElevationCell& c = frame.cell(idx);
 		const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
 		const double x = g.cx(cx), y = g.cy(cy);
-		const double dx = x - sensor.x(), dy = y - sensor.y();
+		const double dx = x - sx, dy = y - sy;
 		const double r2 = dx * dx + dy * dy;
 		m_classCells.push_back(idx);
 		if (r2 > maxR2)
@@ -373,20 +369,90 @@ void InverseSensorModel::computePaper(
 		m_class[idx] = cls;
 		(cls == VoxelClass::Ground ? stats.ground : cls == VoxelClass::Drop ? stats.drop : stats.obstacle)++;
 		const float peak =
-			ground ? 1.f : float(std::max(0.5, paper::densityConfidence(c.count, c.span(), m_params, res)));
-		const double len = std::sqrt(r2);
-		const double ux = len > 0 ? dx / len : 0, uy = len > 0 ? dy / len : 0;
-		const size_t steps = std::min(kmax - 1, size_t(len / res));
-		int last = -1;
-		for (size_t k = 0; k <= steps; k++)
+			ground ? 0.f : float(std::max(0.5, paper::densityConfidence(c.count, c.span(), m_params, res)));
+		put(idx, ground ? float(paper::groundRay(0, 0, m_params)) : peak);
+		const double dist = std::sqrt(r2);
+		const int last = fan.lastSample(dist);
+		if (last >= 0) m_paperVoxels.push_back({idx, fan.binOf(dx, dy), last, float(dist), peak});
+	}
+
+	// 2. Sort by bin, and within a bin farthest first: two stable counting
+	// sorts (last sample descending, then bin), O(voxels + bins + samples).
+	const size_t n = m_paperVoxels.size();
+	m_paperSorted.resize(n);
+	const int samples = fan.lastSample(m_maxRange) + 1;
+	m_paperCount.assign(size_t(std::max(samples, fan.bins)) + 1, 0);
+	for (const PaperVoxel& v : m_paperVoxels) m_paperCount[size_t(samples - 1 - v.last) + 1]++;
+	for (size_t i = 1; i < m_paperCount.size(); i++) m_paperCount[i] += m_paperCount[i - 1];
+	for (const PaperVoxel& v : m_paperVoxels) m_paperSorted[m_paperCount[size_t(samples - 1 - v.last)]++] = v;
+	std::fill(m_paperCount.begin(), m_paperCount.end(), 0);
+	for (const PaperVoxel& v : m_paperSorted) m_paperCount[size_t(v.bin) + 1]++;
+	for (size_t i = 1; i < m_paperCount.size(); i++) m_paperCount[i] += m_paperCount[i - 1];
+	for (const PaperVoxel& v : m_paperSorted) m_paperVoxels[m_paperCount[size_t(v.bin)]++] = v;
+
+	// 3. Sweep each bin's ray from its farthest voxel to the sensor. At a
+	// sample, the ground voxels beyond it give K_g + (0.5 - K_g) / (1 + e^delta)
+	// (delta = |c_v| - r_k), strongest for the farthest one; each obstacle voxel
+	// beyond it gives max(P_rho, 0.5) exp(-delta^2 / 2 sigma^2), which falls to
+	// the floor within a few decimetres and stays there.
+	const double twoSigma2 = 2.0 * m_params.sigma2;
+	for (size_t i = 0; i < n;)
+	{
+		const int bin = m_paperVoxels[i].bin;
+		const double ux = std::cos(fan.angle(bin)), uy = std::sin(fan.angle(bin));
+		double farGround = -1;   // |c_v| of the farthest ground voxel reached so far
+		bool saturated = false;  // an obstacle's evidence has fallen to the floor
+		m_paperActive.clear();
+		int lastCell = -1;
+		float lastP = 0.5f;
+		// The bin's first voxel reaches the most samples: when k reaches 0,
+		// every voxel of the bin has been taken in.
+		for (int k = m_paperVoxels[i].last; k >= 0; k--)
 		{
-			const double px = x - ux * (double(k) * res), py = y - uy * (double(k) * res);
-			const int qx = int(std::floor((px - g.x_min) / res)), qy = int(std::floor((py - g.y_min) / res));
+			for (; i < n && m_paperVoxels[i].bin == bin && m_paperVoxels[i].last >= k; i++)
+			{
+				const PaperVoxel& v = m_paperVoxels[i];
+				if (v.peak == 0.f)
+					farGround = std::max(farGround, double(v.dist));
+				else
+					m_paperActive.push_back(v);
+			}
+			const double r = fan.radius(k);
+			float occ = 0.5f, fr = saturated ? floorP : 0.5f;
+			if (farGround >= r)
+				fr = std::min(fr, float(m_params.K_g + (0.5 - m_params.K_g) / (1.0 + std::exp(farGround - r))));
+			for (size_t j = 0; j < m_paperActive.size();)
+			{
+				const double d = double(m_paperActive[j].dist) - r;
+				const float p = float(m_paperActive[j].peak * std::exp(-d * d / twoSigma2));
+				if (p > 0.5f)
+				{
+					occ = std::max(occ, p);
+					j++;
+					continue;
+				}
+				// Free from here to the sensor, and falling: once one obstacle's
+				// evidence reaches the floor, no free evidence can beat it.
+				if (p <= floorP) saturated = true;
+				if (saturated)
+				{
+					fr = floorP;
+					m_paperActive[j] = m_paperActive.back();
+					m_paperActive.pop_back();
+					continue;
+				}
+				fr = std::min(fr, p);
+				j++;
+			}
+			const float p = occ > 0.5f ? occ : fr;
+			if (p == 0.5f) continue;
+			const int qx = g.ix(sx + r * ux), qy = g.iy(sy + r * uy);
 			if (!g.inside(qx, qy)) continue;
 			const int q = int(g.index(qx, qy));
-			if (q == last) continue;
-			last = q;
-			put(uint32_t(q), ground ? m_lutGround[k] : peak * m_lutGauss[k]);
+			if (q == lastCell && p == lastP) continue;
+			lastCell = q;
+			lastP = p;
+			put(uint32_t(q), p);
 		}
 	}
 }

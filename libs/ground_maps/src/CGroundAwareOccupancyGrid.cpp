@@ -271,7 +271,7 @@ void CGroundAwareOccupancyGrid::applyEvidence()
 		const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
 		const int wx = x2idx(g.cx(cx)), wy = y2idx(g.cy(cy));
 		if (wx < 0 || wy < 0 || wx >= sx || wy >= sy) continue;
-		const float pFree = std::clamp(1.0f - ev[c], 0.001f, 0.999f);
+		const float pFree = std::clamp(1.0f - ev[c], gam::ism::kEvidenceFloor, 1.0f - gam::ism::kEvidenceFloor);
 		const int l = int(p2l(pFree));
 		cellType& cell = m_map[size_t(wx) + size_t(wy) * getSizeX()];
 		cell = cellType(std::clamp(int(cell) + l, int(OCCGRID_CELLTYPE_MIN), int(OCCGRID_CELLTYPE_MAX)));

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -144,6 +145,10 @@ inline float combine(float a, float b)
 	if (a > 0.5f || b > 0.5f) return a > b ? a : b;
 	return a < b ? a : b;
 }
+/** The strongest evidence a cell can get in one frame: P(occ) in
+ * [kEvidenceFloor, 1 - kEvidenceFloor]. The grid clamps every update to it,
+ * so evidence beyond it would change nothing. */
+constexpr float kEvidenceFloor = 0.001f;
 }  // namespace ism
 
 /** The paper's model (ism_model = paper), written as printed:
@@ -162,6 +167,36 @@ double voxelVolume(double span, double resolution);
 double densityConfidence(uint32_t count, double span, const IsmParams& p, double resolution);
 double obstacleRay(double cDist, double cvDist, double pRho, const IsmParams& p);
 double groundRay(double cDist, double cvDist, const IsmParams& p);
+
+/** The rays of the paper model, discretized: angular bins around the sensor,
+ * fine enough that neighbouring rays are half a cell apart at the maximum
+ * range, each sampled every d_r from the sensor at r_k = (k + 1/2) d_r. A
+ * voxel's ray is the ray of its bin (within d_r / 4 of its true line) and
+ * reaches the samples with r_k <= |c_v|; the cells of a ray are the cells
+ * holding its samples. All voxels of a bin share its samples, which lets
+ * computePaper() sweep each bin once from far to near. */
+struct RayFan
+{
+	RayFan(double resolution, double maxRange)
+		: res(resolution),
+		  bins(std::max(8, int(std::ceil(4.0 * M_PI * maxRange / resolution)))),
+		  dtheta(2.0 * M_PI / bins)
+	{
+	}
+	double res;
+	int bins;
+	double dtheta;
+	/** The bin of the direction (dx, dy) from the sensor. */
+	int binOf(double dx, double dy) const
+	{
+		const int b = int(std::lround(std::atan2(dy, dx) / dtheta));
+		return ((b % bins) + bins) % bins;
+	}
+	double angle(int bin) const { return bin * dtheta; }
+	double radius(int k) const { return (k + 0.5) * res; }
+	/** The last sample a voxel at 2D distance `dist` reaches (-1: none). */
+	int lastSample(double dist) const { return int(std::floor(dist / res - 0.5 + 1e-9)); }
+};
 }  // namespace paper
 
 enum class VoxelClass : uint8_t
@@ -225,7 +260,18 @@ class InverseSensorModel
 	void put(uint32_t cell, float p);
 	void computePaper(
 		const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, IsmStats& stats);
-	std::vector<float> m_lutGround, m_lutGauss;  ///< eq. (5) per whole cell behind the voxel (paper model)
+	// Paper model workspace: in-range voxels sorted by (bin, distance
+	// descending) with two counting sorts, and a bin's obstacle voxels whose
+	// ray evidence has not yet fallen to kEvidenceFloor.
+	struct PaperVoxel
+	{
+		uint32_t cell;
+		int bin, last;  ///< ray bin; last sample reached (RayFan::lastSample)
+		float dist;     ///< |c_v| [m]
+		float peak;     ///< max(P_rho, 0.5); 0 for a ground voxel
+	};
+	std::vector<PaperVoxel> m_paperVoxels, m_paperSorted, m_paperActive;
+	std::vector<uint32_t> m_paperCount;
 	const Plane& choosePlane(const GroundDetection& det, const ElevationCell& c, double x, double y, int block) const;
 	void buildSupport(const GridGeometry& g, const GroundDetection& det);
 	void measureFloorNoise(const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor);
