@@ -308,3 +308,49 @@ TEST(PaperRrt, StepsOfExactlyDnAndTheFallbackThroughANeighbour)
 		if (parentDistance(dd, dd.nodes[i]) < 0.4 - snap) shortSteps++;
 	EXPECT_GT(shortSteps, 0u);
 }
+
+TEST(PaperRrt, SearchWindowDriftsTowardTheNodes)
+{
+	const GridGeometry g = gamtest::makeGeometry(-3, -3, 0.05, 120, 120);  // -3..3 m
+	PaperSearchWindow w;
+	w.add(0.0, 0.0);  // the seed
+	double x0, x1, y0, y1;
+	// One node: centred on it, half side = the margin (1 m).
+	w.bounds(g, 1.0, x0, x1, y0, y1);
+	EXPECT_DOUBLE_EQ(x0, -1.0);
+	EXPECT_DOUBLE_EQ(x1, 1.0);
+	EXPECT_DOUBLE_EQ(y0, -1.0);
+	EXPECT_DOUBLE_EQ(y1, 1.0);
+	// Nodes at (0.4, 0) and (0.8, 0.4): centroid (1.2 / 3, 0.4 / 3) = (0.4, 0.13333).
+	// x: largest offset max(0.4 - 0, 0.8 - 0.4) = 0.4, half side 1.4 -> [-1.0, 1.8];
+	// y: max(0.13333 - 0, 0.4 - 0.13333) = 0.26667, half side 1.26667
+	//    -> [0.13333 - 1.26667, 0.13333 + 1.26667] = [-1.13333, 1.4].
+	w.add(0.4, 0.0);
+	w.add(0.8, 0.4);
+	w.bounds(g, 1.0, x0, x1, y0, y1);
+	EXPECT_NEAR(x0, -1.0, 1e-12);
+	EXPECT_NEAR(x1, 1.8, 1e-12);
+	EXPECT_NEAR(y0, -1.133333333333, 1e-9);
+	EXPECT_NEAR(y1, 1.4, 1e-12);
+	// Five more nodes far along +x at (2.4, 0): centroid x = (1.2 + 12) / 8 = 1.65;
+	// largest offset max(1.65 - 0, 2.4 - 1.65) = 1.65, half side 2.65 ->
+	// [-1.0, 4.3], cut by the grid to [-1.0, 3.0]. The window's centre moved
+	// from the seed to x = 1.65, toward the explored nodes.
+	for (int i = 0; i < 5; i++) w.add(2.4, 0.0);
+	w.bounds(g, 1.0, x0, x1, y0, y1);
+	EXPECT_NEAR(x0, -1.0, 1e-12);
+	EXPECT_DOUBLE_EQ(x1, 3.0);
+	// The tree on a floor: every node lies in the final window, the window
+	// has left the seed's [-1, 1]^2 box, and the nodes spread beyond it.
+	const ElevationGrid grid = noisyFloor(0.003);
+	RrtGpdParams rp;
+	rp.variant = MethodVariant::Paper;
+	RrtGroundDetector rrt(rp);
+	GroundDetection d;
+	rrt.detect(grid, GroundSeedHint{}, d);
+	ASSERT_TRUE(d.ok()) << d.describe();
+	double far = 0;
+	for (const GroundNode& n : d.nodes)
+		far = std::max(far, std::max(std::abs(double(n.x - d.nodes[0].x)), std::abs(double(n.y - d.nodes[0].y))));
+	EXPECT_GT(far, 1.0 + 0.4) << "the tree never left the seed's first window";
+}

@@ -221,4 +221,18 @@ size_t ElevationGrid::interpolateIdw(const IdwParams& p)
 	return filled;
 }
 
+size_t ElevationGrid::promoteIdwCells()
+{
+	size_t n = 0;
+	for (uint32_t i : m_idwTouched)
+	{
+		ElevationCell& c = m_cells[i];
+		if (c.count || !std::isfinite(c.z_idw)) continue;
+		c.add(c.z_idw);
+		m_touched.push_back(i);
+		n++;
+	}
+	return n;
+}
+
 }  // namespace gam

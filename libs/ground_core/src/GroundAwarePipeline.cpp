@@ -99,7 +99,11 @@ const FrameResult& GroundAwarePipeline::process(
 	m_result.samples = binSensorFrame(frame, m_params.projectionFilter(robot.z()), m_grid, m_projector, m_bins);
 	const auto t1 = clk::now();
 	m_result.points = m_grid.insert(m_bins, m_params.outliers);
-	if (m_params.idw.radius_cells > 0) m_grid.interpolateIdw(m_params.idw);
+	if (m_params.idw.radius_cells > 0)
+	{
+		m_grid.interpolateIdw(m_params.idw);
+		if (m_params.idw_in_ism) m_grid.promoteIdwCells();
+	}
 	const auto t2 = clk::now();
 
 	// 2. Ground: RRT-GPD seeded under the robot.

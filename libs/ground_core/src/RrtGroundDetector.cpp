@@ -400,8 +400,8 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 	//    other node within d_n of it, nearest first, against which it passes.
 	const GridGeometry& g = grid.geometry();
 	startTree(g, seed, out);
-	double sumX = seed.x, sumY = seed.y;
-	double bx0 = seed.x, bx1 = seed.x, by0 = seed.y, by1 = seed.y;
+	PaperSearchWindow window;
+	window.add(seed.x, seed.y);
 	std::uniform_real_distribution<double> U(0.0, 1.0);
 	const double dn = m_params.expansion_distance, margin = m_params.window_margin;
 	const float dn2 = float(dn * dn);
@@ -409,11 +409,8 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 	for (int k = 0; k < m_params.iterations; k++)
 	{
 		out.iterations = k + 1;
-		const double n = double(out.nodes.size());
-		const double mx = sumX / n, my = sumY / n;
-		const double hx = std::max(mx - bx0, bx1 - mx) + margin, hy = std::max(my - by0, by1 - my) + margin;
-		const double wx0 = std::max(g.x_min, mx - hx), wx1 = std::min(g.x_max(), mx + hx);
-		const double wy0 = std::max(g.y_min, my - hy), wy1 = std::min(g.y_max(), my + hy);
+		double wx0, wx1, wy0, wy1;
+		window.bounds(g, margin, wx0, wx1, wy0, wy1);
 		const double qx = wx0 + U(m_rng) * (wx1 - wx0), qy = wy0 + U(m_rng) * (wy1 - wy0);
 
 		float nearD2 = 0;
@@ -461,12 +458,7 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 		node.local = pl;
 		node.parent = parent;
 		addTreeNode(g, node, cx, cy, out);
-		sumX += px;
-		sumY += py;
-		bx0 = std::min(bx0, px);
-		bx1 = std::max(bx1, px);
-		by0 = std::min(by0, py);
-		by1 = std::max(by1, py);
+		window.add(px, py);
 	}
 }
 

@@ -229,6 +229,10 @@ class ElevationGrid
 	 * Returns how many cells got an estimate. Restricted to the bounding box of
 	 * the observed cells grown by r. */
 	size_t interpolateIdw(const IdwParams& p);
+	/** Turns every cell that holds only an IDW estimate into an observed cell
+	 * of one sample at that height (the paper's densified map). Returns how
+	 * many. clear() and recenter() empty them like any observed cell. */
+	size_t promoteIdwCells();
 
 	/** Surface height of a cell for ground fitting: the mean of an observed cell,
 	 * else the IDW estimate; NaN if neither. */

@@ -30,7 +30,12 @@ struct PipelineParams
 	 * points above ism.robot_height are dropped too (see projectionFilter()). */
 	ProjectionFilter projection = {0.0f, 5.0f, -3.0f, 2.5f, 1};
 	OutlierFilterParams outliers;  ///< 3-sigma rule
-	IdwParams idw = {1, 2.0f, 3};  ///< IDW, for the local plane fits only
+	IdwParams idw = {1, 2.0f, 3};  ///< IDW, for the local plane fits only (see idw_in_ism)
+	/** The paper densifies the 2.5D map with IDW before the ISM: with this on,
+	 * every IDW cell enters the ISM as a one-sample voxel at its estimated
+	 * height (one estimate is one sample). Off by default: an estimate is no
+	 * measurement, and only the plane fits use it. */
+	bool idw_in_ism = false;
 	RrtGpdParams rrt;
 	IsmParams ism;
 
@@ -42,6 +47,8 @@ struct PipelineParams
 		ProjectionFilter::forEachParam(p.projection, visit);
 		OutlierFilterParams::forEachParam(p.outliers, visit);
 		IdwParams::forEachParam(p.idw, visit);
+		visit(
+			ParamInfo{"idw_in_ism", 0, 1, "IDW cells enter the ISM as one-sample voxels (paper Fig. 4)"}, p.idw_in_ism);
 		RrtGpdParams::forEachParam(p.rrt, visit);
 		IsmParams::forEachParam(p.ism, visit);
 	}

@@ -4,6 +4,7 @@
 // followed by RANSAC on the node centres. Pure code over a read-only grid.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -145,6 +146,38 @@ struct GroundSeedHint
 {
 	double x = 0, y = 0;  ///< robot position in the grid frame
 	double floor_z = 0;   ///< expected floor height in the grid frame
+};
+
+/** Algorithm 1's search window (rrt_variant = paper): centred on the centroid
+ * of the explored nodes, so it drifts toward them as the tree grows; its half
+ * side along each axis is the nodes' largest offset from the centroid plus a
+ * margin, cut to the grid. */
+struct PaperSearchWindow
+{
+	double sum_x = 0, sum_y = 0;
+	size_t nodes = 0;
+	double x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;  ///< bounding box of the nodes
+
+	void add(double x, double y)
+	{
+		x_lo = nodes ? std::min(x_lo, x) : x;
+		x_hi = nodes ? std::max(x_hi, x) : x;
+		y_lo = nodes ? std::min(y_lo, y) : y;
+		y_hi = nodes ? std::max(y_hi, y) : y;
+		sum_x += x;
+		sum_y += y;
+		nodes++;
+	}
+	/** The window [x0, x1] x [y0, y1] (needs one node at least). */
+	void bounds(const GridGeometry& g, double margin, double& x0, double& x1, double& y0, double& y1) const
+	{
+		const double mx = sum_x / double(nodes), my = sum_y / double(nodes);
+		const double hx = std::max(mx - x_lo, x_hi - mx) + margin, hy = std::max(my - y_lo, y_hi - my) + margin;
+		x0 = std::max(g.x_min, mx - hx);
+		x1 = std::min(g.x_max(), mx + hx);
+		y0 = std::max(g.y_min, my - hy);
+		y1 = std::min(g.y_max(), my + hy);
+	}
 };
 
 class RrtGroundDetector
