@@ -15,11 +15,11 @@
 // exit: 0 ok, 1 bad input or unwritable output, 2 command line.
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/config/CConfigFileMemory.h>
-#include <mrpt/maps/CMultiMetricMap.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/img/color_maps.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
+#include <mrpt/maps/CMultiMetricMap.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -95,7 +95,8 @@ std::vector<Frame> loadFrames(const std::string& file)
 			d->load();
 			out.push_back({d, nullptr, pose});
 		}
-		if (auto s = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(o)) out.push_back({nullptr, s, pose});
+		if (auto s = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(o))
+			out.push_back({nullptr, s, pose});
 	}
 	if (std::none_of(out.begin(), out.end(), [](const Frame& f) { return bool(f.depth); }))
 		throw Failure(file + " has no CObservation3DRangeScan");
@@ -237,7 +238,8 @@ ConfiguredMaps loadConfig(const std::string& path)
 	return {*ga, *hb};
 }
 
-void applyOptions(CGroundAwareOccupancyGrid& g, const std::function<void(CGroundAwareOccupancyGrid::TGroundAwareOptions&)>& edit)
+void applyOptions(
+	CGroundAwareOccupancyGrid& g, const std::function<void(CGroundAwareOccupancyGrid::TGroundAwareOptions&)>& edit)
 {
 	auto o = g.groundOptions();
 	edit(o);
@@ -297,9 +299,9 @@ int figure4(
 	const ConfiguredMaps& cfg, const std::vector<std::string>& rawlogs, const std::vector<std::string>& gts,
 	const std::string& out, std::vector<Row>& rows)
 {
-	const std::vector<std::string> titles = {
-		"point cloud", "2.5D, no outlier removal", "2D, with outliers", "2D, 3-sigma",
-		"height band 0.2-1.5 m", "2D, 3-sigma + IDW", "ours (default)"};
+	const std::vector<std::string> titles = {"point cloud",   "2.5D, no outlier removal", "2D, with outliers",
+											 "2D, 3-sigma",   "height band 0.2-1.5 m",    "2D, 3-sigma + IDW",
+											 "ours (default)"};
 	const int panel = 300, cols = int(titles.size());
 	const int rowH = panelLabelHeight + panel + gap + 14;
 	CImage im(gap + cols * (panel + gap), 24 + int(rawlogs.size()) * rowH, mrpt::img::CH_RGB);
@@ -335,7 +337,8 @@ int figure4(
 			o.pipeline.idw_in_ism = true;
 		});
 		CHeightBandOccupancyGrid band = cfg.heightBand;
-		for (COccupancyGridMap2D* m : std::initializer_list<COccupancyGridMap2D*>{&withOutliers, &sigma, &idw, &ours, &band})
+		for (COccupancyGridMap2D* m :
+			 std::initializer_list<COccupancyGridMap2D*>{&withOutliers, &sigma, &idw, &ours, &band})
 			m->insertObservation(*f.depth, f.pose);
 
 		const std::string scene = mrpt::system::extractFileName(rawlogs[s]);
@@ -365,7 +368,9 @@ int figure4(
 	return 0;
 }
 
-int figure5(const ConfiguredMaps& cfg, const std::string& rawlog, const std::string& gtPrefix, const std::string& out, int cells, std::vector<Row>& rows)
+int figure5(
+	const ConfiguredMaps& cfg, const std::string& rawlog, const std::string& gtPrefix, const std::string& out,
+	int cells, std::vector<Row>& rows)
 {
 	const std::vector<Frame> frames = loadFrames(rawlog);
 	std::unique_ptr<gam::eval::GroundTruth> gt;
@@ -410,7 +415,9 @@ int figure5(const ConfiguredMaps& cfg, const std::string& rawlog, const std::str
 	im.filledRectangle(0, 0, int(im.getWidth()) - 1, int(im.getHeight()) - 1, TColor(255, 255, 255));
 	char head[256];
 	std::snprintf(
-		head, sizeof head, "Fig. 5 reproduced: %s, %zu depth frames + %zu Leddar scans; %d x %d local maps (%.0f m) at the last pose; red: path",
+		head, sizeof head,
+		"Fig. 5 reproduced: %s, %zu depth frames + %zu Leddar scans; %d x %d local maps (%.0f m) at the last pose; "
+		"red: path",
 		mrpt::system::extractFileName(rawlog).c_str(), depthFrames, scans, cells, cells, side);
 	im.textOut(gap, 4, head, kText);
 	for (int k = 0; k < 4; k++)
@@ -420,10 +427,11 @@ int figure5(const ConfiguredMaps& cfg, const std::string& rawlog, const std::str
 		drawGrid(im, ox, oy + panelLabelHeight, v, *grids[k]);
 		for (size_t i = 1; i < path.size(); i++)
 			im.line(
-				ox + v.col(path[i - 1].first), oy + panelLabelHeight + v.row(path[i - 1].second), ox + v.col(path[i].first),
-				oy + panelLabelHeight + v.row(path[i].second), TColor(220, 0, 0), 2);
+				ox + v.col(path[i - 1].first), oy + panelLabelHeight + v.row(path[i - 1].second),
+				ox + v.col(path[i].first), oy + panelLabelHeight + v.row(path[i].second), TColor(220, 0, 0), 2);
 		rows.push_back(
-			{mrpt::system::extractFileName(rawlog), titles[size_t(k)], describe(*grids[k], v, gt.get(), titles[size_t(k)])});
+			{mrpt::system::extractFileName(rawlog), titles[size_t(k)],
+			 describe(*grids[k], v, gt.get(), titles[size_t(k)])});
 	}
 	if (!im.saveToFile(out)) throw Failure("cannot write " + out);
 	return 0;
@@ -436,8 +444,10 @@ int main(int argc, char** argv)
 	{
 		TCLAP::CmdLine cmd("gam-figure: the paper's Fig. 4 and Fig. 5, reproduced (issue #12)", ' ', "1.0");
 		TCLAP::ValueArg<int> argFig("", "figure", "4 or 5", true, 4, "N", cmd);
-		TCLAP::MultiArg<std::string> argRawlog("", "rawlog", "simulated rawlog (Fig. 4: one per row)", true, "FILE", cmd);
-		TCLAP::MultiArg<std::string> argGt("", "gt", "ground-truth prefix of gam-simulate, one per rawlog", false, "PREFIX", cmd);
+		TCLAP::MultiArg<std::string> argRawlog(
+			"", "rawlog", "simulated rawlog (Fig. 4: one per row)", true, "FILE", cmd);
+		TCLAP::MultiArg<std::string> argGt(
+			"", "gt", "ground-truth prefix of gam-simulate, one per rawlog", false, "PREFIX", cmd);
 		TCLAP::ValueArg<std::string> argOut("", "out", "PNG to write", true, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> argCsv("", "csv", "also write the figures per panel", false, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> argConfig(
@@ -459,7 +469,8 @@ int main(int argc, char** argv)
 		else if (argFig.getValue() == 5)
 		{
 			if (argRawlog.getValue().size() != 1) throw Failure("--figure 5 takes one --rawlog");
-			if (argCells.getValue() < 10 || argCells.getValue() > 10000) throw Failure("--cells must be in [10, 10000]");
+			if (argCells.getValue() < 10 || argCells.getValue() > 10000)
+				throw Failure("--cells must be in [10, 10000]");
 			figure5(
 				cfg, argRawlog.getValue()[0], argGt.getValue().empty() ? "" : argGt.getValue()[0], argOut.getValue(),
 				argCells.getValue(), rows);
