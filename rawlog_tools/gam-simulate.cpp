@@ -37,6 +37,16 @@ mrpt::poses::CPose3D toCPose3D(const Pose3& p)
 	return mrpt::poses::CPose3D(p.t.x(), p.t.y(), p.t.z(), a[0], a[1], a[2]);
 }
 
+/** "a,b,c" -> three numbers; throws naming the option. */
+Eigen::Vector3d parseTriple(const std::string& opt, const std::string& v)
+{
+	Eigen::Vector3d out;
+	char extra = 0;
+	if (std::sscanf(v.c_str(), "%lf,%lf,%lf%c", &out[0], &out[1], &out[2], &extra) != 3 || !out.allFinite())
+		throw std::invalid_argument("--" + opt + " wants three numbers a,b,c (got '" + v + "')");
+	return out;
+}
+
 /** Grey level per label in PREFIX_gt.pgm. */
 uint8_t grey(Label l)
 {
@@ -118,6 +128,16 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<int> argFrames("", "frames", "keep only the first N frames", false, 0, "N", cmd);
 		TCLAP::SwitchArg argNoNoise("", "no-noise", "exact sensors and odometry", cmd);
 		TCLAP::SwitchArg argNoLeddar("", "no-leddar", "do not simulate the Leddar", cmd);
+		TCLAP::ValueArg<std::string> argMount(
+			"", "mount",
+			"the Kinect's true height, pitch and roll on the robot: z,pitch,roll [m, deg] (x, y, yaw stay the "
+			"scene's)",
+			false, "", "Z,PITCH,ROLL", cmd);
+		TCLAP::ValueArg<std::string> argDeclared(
+			"", "declared-offset",
+			"write the Kinect's sensorPose off the true one by dz,dpitch,droll [m, deg]: a wrong declared mount "
+			"(the frames are rendered with the true one)",
+			false, "", "DZ,DPITCH,DROLL", cmd);
 		TCLAP::SwitchArg argDepthPgm(
 			"", "depth-images", "also write PREFIX_depth_NNNN.pgm (16-bit, millimetres) per frame", cmd);
 		cmd.parse(argc, argv);
@@ -154,7 +174,45 @@ int main(int argc, char** argv)
 
 		const KinectModel kinect(sf.kinect);
 		const LeddarModel leddar(sf.leddar);
-		const mrpt::poses::CPose3D kinPose = toCPose3D(sf.kinect_pose), ledPose = toCPose3D(sf.leddar_pose);
+		if (!argMount.getValue().empty())
+		{
+			const Eigen::Vector3d m = parseTriple("mount", argMount.getValue());
+			if (!(m[0] > 0) || std::abs(m[1]) >= 90 || std::abs(m[2]) >= 90)
+				throw std::invalid_argument("--mount: z must be > 0 and |pitch|, |roll| < 90 deg");
+			const Eigen::Vector3d a = sf.kinect_pose.ypr();
+			sf.kinect_pose = Pose3::fromXYZYPR(
+				sf.kinect_pose.t.x(), sf.kinect_pose.t.y(), m[0], a[0], m[1] * M_PI / 180, m[2] * M_PI / 180);
+		}
+		// The pose written into the rawlog (the true one unless --declared-offset).
+		Pose3 declared = sf.kinect_pose;
+		if (!argDeclared.getValue().empty())
+		{
+			const Eigen::Vector3d d = parseTriple("declared-offset", argDeclared.getValue());
+			const Eigen::Vector3d a = sf.kinect_pose.ypr();
+			declared = Pose3::fromXYZYPR(
+				sf.kinect_pose.t.x(), sf.kinect_pose.t.y(), sf.kinect_pose.t.z() + d[0], a[0], a[1] + d[1] * M_PI / 180,
+				a[2] + d[2] * M_PI / 180);
+		}
+		const mrpt::poses::CPose3D kinPose = toCPose3D(declared), ledPose = toCPose3D(sf.leddar_pose);
+		{
+			// The true and the declared mount, for scoring a calibration.
+			const std::filesystem::path parent = std::filesystem::path(prefix).parent_path();
+			std::error_code ec;
+			if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+			std::ofstream f(prefix + "_gt_sensors.csv");
+			f << "label,kind,x,y,z,yaw_deg,pitch_deg,roll_deg\n";
+			for (const auto& [kind, p] :
+				 {std::pair<const char*, Pose3>{"true", sf.kinect_pose}, {"declared", declared}})
+			{
+				const Eigen::Vector3d a = p.ypr() * 180.0 / M_PI;
+				char b[200];
+				std::snprintf(
+					b, sizeof b, "KINECT,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", kind, p.t.x(), p.t.y(), p.t.z(), a[0],
+					a[1], a[2]);
+				f << b;
+			}
+			if (!f) throw std::runtime_error("cannot write " + prefix + "_gt_sensors.csv");
+		}
 
 		{
 			// create the output folder if needed

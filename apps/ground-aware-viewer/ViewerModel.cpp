@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
@@ -302,6 +303,17 @@ std::string ViewerModel::statusText() const
 	}
 	else
 		o << "(no 3D scan in this step)\n";
+	for (const auto& [label, monitor] : m_ga->mountChecks())
+	{
+		const MountStatus& ms = monitor.status();
+		if (!ms.has_last) continue;
+		if (ms.alarm) o << "WARNING: MOUNT ALARM, " << label << "'s declared sensorPose disagrees with the floor\n";
+		o << "mount " << label << ": measured z " << std::setprecision(3) << ms.estimate.height << " m, pitch "
+		  << std::setprecision(2) << mrpt::RAD2DEG(ms.estimate.pitch) << ", roll " << mrpt::RAD2DEG(ms.estimate.roll)
+		  << " deg; declared z " << std::setprecision(3) << ms.declared.height << ", pitch " << std::setprecision(2)
+		  << mrpt::RAD2DEG(ms.declared.pitch) << ", roll " << mrpt::RAD2DEG(ms.declared.roll) << "; "
+		  << ms.frames_disagreeing << " of " << ms.frames_checked << " frames disagree\n";
+	}
 	o << "insert [ms]: ground_aware " << m_timing.groundAware << ", height_band " << m_timing.heightBand << ", octomap "
 	  << m_timing.octomap << ", elevation " << m_timing.elevation << "\n";
 	return o.str();

@@ -293,7 +293,7 @@ void checkOutputs(const std::string& dir)
 		std::ifstream f(dir + "/ground_planes.csv");
 		std::string h;
 		std::getline(f, h);
-		EXPECT_EQ(h, "frame,a,b,c,d,nodes,status");
+		EXPECT_EQ(h, "frame,a,b,c,d,nodes,status,mount_z,mount_pitch_deg,mount_roll_deg,mount_alarm");
 	}
 	{
 		std::ifstream f(dir + "/timing.csv");

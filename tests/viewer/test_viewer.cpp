@@ -167,6 +167,31 @@ TEST_F(Viewer, ModelMatchesTheBatchRun)
 	EXPECT_GE(hb.getPos(2.5, 0.0), 0.5f);
 }
 
+TEST_F(Viewer, StatusWarnsOfAWrongDeclaredMount)
+{
+	// The fixture's rawlog declares the true mount: measured, no alarm.
+	const std::string ok = model->statusText();
+	EXPECT_NE(ok.find("mount KINECT: measured z 1.00"), std::string::npos) << ok;
+	EXPECT_EQ(ok.find("MOUNT ALARM"), std::string::npos) << ok;
+	// Declared 8 cm higher and 4 deg more pitched than it is: the alarm is on
+	// after 5 disagreeing frames.
+	std::string out;
+	ASSERT_EQ(
+		run(std::string(GAM_SIMULATE_EXE) + " --scene " + GAM_SOURCE_DIR + "/config/scenes/nav_hole.scene --out " +
+				kTmp + "/wrong --no-leddar --frames 8 --declared-offset 0.08,4,0",
+			&out),
+		0)
+		<< out;
+	ViewerModel wrong;
+	wrong.openRawlog(kTmp + "/wrong.rawlog");
+	wrong.seek(3);
+	EXPECT_EQ(wrong.statusText().find("MOUNT ALARM"), std::string::npos) << "4 frames: not yet";
+	wrong.seek(7);
+	const std::string st = wrong.statusText();
+	EXPECT_NE(st.find("WARNING: MOUNT ALARM, KINECT"), std::string::npos) << st;
+	EXPECT_NE(st.find("declared z 1.080, pitch 29.00"), std::string::npos) << st;
+}
+
 TEST_F(Viewer, ParameterChangeRerunsTheCurrentFrame)
 {
 	ViewerModel m;

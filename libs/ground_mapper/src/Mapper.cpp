@@ -1,3 +1,4 @@
+#include <gam/common/Strings.h>
 #include <gam/mapper/Errors.h>
 #include <gam/mapper/Mapper.h>
 #include <gam/mapper/RawlogFrames.h>
@@ -69,7 +70,29 @@ std::string RunSummary::text() const
 			s << std::setw(12) << fmtMs(percentile(m.ms2D, 0.5)) << std::setw(12) << fmtMs(percentile(m.ms2D, 0.95));
 		s << "\n";
 	}
+	for (const auto& n : notes) s << n << "\n";
 	return s.str();
+}
+
+std::map<std::string, mrpt::poses::CPose3D> readSensorPoses(
+	const mrpt::config::CConfigFileBase& ini, const std::string& configName)
+{
+	std::map<std::string, mrpt::poses::CPose3D> out;
+	std::vector<std::string> keys;
+	ini.getAllKeys("sensor_poses", keys);
+	for (const std::string& label : keys)
+	{
+		const std::string v = gam::stripIniComment(ini.read_string("sensor_poses", label, "", false));
+		double x, y, z, yaw, pitch, roll;
+		char extra = 0;
+		if (std::sscanf(v.c_str(), "%lf %lf %lf %lf %lf %lf %c", &x, &y, &z, &yaw, &pitch, &roll, &extra) != 6 ||
+			!std::isfinite(x + y + z + yaw + pitch + roll))
+			throw ConfigError(
+				configName + ": [sensor_poses] " + label + "=" + v +
+				": expected six numbers, x y z [m] yaw pitch roll [deg]");
+		out[label] = mrpt::poses::CPose3D(x, y, z, yaw * M_PI / 180, pitch * M_PI / 180, roll * M_PI / 180);
+	}
+	return out;
 }
 
 // ---------------------------------------------------------------------------
@@ -95,6 +118,7 @@ Mapper::Mapper(const MapperOptions& opts) : m_opts(opts)
 	{
 		throw ConfigError(m_opts.configName + ": cannot create the maps: " + conciseError(e.what()));
 	}
+	m_sensorPoses = readSensorPoses(ini, m_opts.configName);
 	if (m_maps.maps.size() != m_specs.size())
 		throw ConfigError("internal: CMultiMetricMap created a different number of maps than the .ini defines");
 	for (size_t i = 0; i < m_specs.size(); i++)
@@ -153,7 +177,7 @@ RunSummary Mapper::run()
 	std::ofstream timing(tmp.path + "/timing.csv"), planes(tmp.path + "/ground_planes.csv");
 	if (!timing || !planes) throw RunError("cannot write to " + tmp.path);
 	timing << "frame,map,stage,ms\n";
-	planes << "frame,a,b,c,d,nodes,status\n";
+	planes << "frame,a,b,c,d,nodes,status,mount_z,mount_pitch_deg,mount_roll_deg,mount_alarm\n";
 	planes << std::setprecision(9);
 	timing << std::fixed << std::setprecision(4);
 
@@ -196,6 +220,11 @@ RunSummary Mapper::run()
 				throw RunError(e.what());
 			}
 			if (m_opts.maxFrames && fr.index >= m_opts.maxFrames) break;
+			if (!m_sensorPoses.empty())
+			{
+				const auto sp = m_sensorPoses.find(fr.obs->sensorLabel);
+				if (sp != m_sensorPoses.end()) fr.obs->setSensorPose(sp->second);
+			}
 			const bool is3D = IS_CLASS(*fr.obs, mrpt::obs::CObservation3DRangeScan);
 			s.frames++;
 			(is3D ? s.frames3D : s.frames2D)++;
@@ -233,7 +262,13 @@ RunSummary Mapper::run()
 						planes << gp.a << "," << gp.b << "," << gp.c << "," << gp.d;
 					else
 						planes << ",,,";
-					planes << "," << gp.nodes << "," << gp.status << "\n";
+					planes << "," << gp.nodes << "," << gp.status << ",";
+					if (gp.mount_measured)
+						planes << gp.mount_z << "," << gp.mount_pitch_deg << "," << gp.mount_roll_deg << ","
+							   << (gp.mount_alarm ? 1 : 0);
+					else
+						planes << ",,,";
+					planes << "\n";
 				}
 			}
 
@@ -270,6 +305,13 @@ RunSummary Mapper::run()
 		throw RunError(
 			"no usable observation in " + m_opts.rawlogPath + " (" + std::to_string(reader->entriesRead()) +
 			" entries; need CObservation3DRangeScan or CObservation2DRangeScan with data)");
+
+	for (size_t i = 0; i < m_specs.size(); i++)
+		if (traits[i] && traits[i]->runNote)
+		{
+			const std::string note = traits[i]->runNote(*m_maps.maps[i]);
+			if (!note.empty()) s.notes.push_back(m_specs[i].label + ": " + note);
+		}
 
 	timing.close();
 	planes.close();

@@ -54,7 +54,41 @@ const bool kTraitsRegistered = [] {
 		}
 		r.nodes = det.nodes.size();
 		r.status = gam::GroundDetection::statusName(det.status);
+		const auto it = g.mountChecks().find(g.lastSensorLabel());
+		if (it != g.mountChecks().end() && it->second.status().has_last && r.found)
+		{
+			const gam::MountStatus& ms = it->second.status();
+			r.mount_measured = true;
+			r.mount_z = ms.last.height;
+			r.mount_pitch_deg = ms.last.pitch * 180.0 / M_PI;
+			r.mount_roll_deg = ms.last.roll * 180.0 / M_PI;
+			r.mount_alarm = ms.alarm;
+		}
 		return true;
+	};
+	t.runNote = [](const CMetricMap& m) {
+		const auto& g = dynamic_cast<const CGroundAwareOccupancyGrid&>(m);
+		std::string out;
+		for (const auto& [label, monitor] : g.mountChecks())
+		{
+			const gam::MountStatus& s = monitor.status();
+			if (!s.frames_checked) continue;
+			const double k = 180.0 / M_PI;
+			char b[512];
+			std::snprintf(
+				b, sizeof b,
+				"sensor mount %s: declared z=%.3f m pitch=%.2f roll=%.2f deg, measured (median of the last %d frames) "
+				"z=%.3f pitch=%.2f roll=%.2f; %zu of %zu frames disagree (tolerance %.3f m, %.2f deg)%s",
+				label.c_str(), s.declared.height, s.declared.pitch * k, s.declared.roll * k,
+				g.groundOptions().mount.window, s.estimate.height, s.estimate.pitch * k, s.estimate.roll * k,
+				s.frames_disagreeing, s.frames_checked, g.groundOptions().mount.tolerance_z,
+				g.groundOptions().mount.tolerance_deg,
+				s.alarm
+					? ": MOUNT ALARM, the declared sensorPose is wrong or the camera moved (gam-calibrate measures it)"
+					: (s.alarms_raised ? ": the alarm was raised and cleared again" : ""));
+			out += (out.empty() ? "" : "\n") + std::string(b);
+		}
+		return out;
 	};
 	gam::maps::registerMapTraits(std::move(t));
 	return true;
@@ -120,7 +154,15 @@ void CGroundAwareOccupancyGrid::setGroundOptions(const TGroundAwareOptions& o)
 {
 	o.validate();
 	m_pipeline.setParams(o.pipeline);
+	for (auto& [label, monitor] : m_mounts) monitor.setParams(o.mount);
 	m_options = o;
+}
+
+bool CGroundAwareOccupancyGrid::mountAlarm() const
+{
+	for (const auto& [label, monitor] : m_mounts)
+		if (monitor.status().alarm) return true;
+	return false;
 }
 
 // ---------------------------------------------------------------------------
@@ -216,9 +258,42 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 	// a frame grid aligned with this grid's cells, fuse its evidence.
 	gam::SensorFrame frame;
 	gam::maps::toSensorFrame(obs, robotPose, frame);
+	// The mount check of this sensor (one per label: several cameras).
+	if (m_lastSensorLabel != obs.sensorLabel) m_lastSensorLabel = obs.sensorLabel;
+	auto mon = m_mounts.find(obs.sensorLabel);
+	if (mon == m_mounts.end()) mon = m_mounts.emplace(obs.sensorLabel, gam::MountMonitor(m_options.mount)).first;
+	mrpt::poses::CPose3D declared;
+	obs.getSensorPose(declared);
+	mrpt::poses::CPose3D used = declared;
+	const gam::MountStatus& ms = mon->second.status();
+	if (m_options.mount.enabled && m_options.mount.use_measured && ms.has_estimate)
+	{
+		// x, y and yaw are not observable from the floor: they stay declared.
+		used = mrpt::poses::CPose3D(
+			declared.x(), declared.y(), ms.estimate.height, declared.yaw(), ms.estimate.pitch, ms.estimate.roll);
+		gam::maps::placeSensor(robotPose + used, frame);
+	}
 	m_pipeline.process(
 		frame, Eigen::Vector3d(robotPose.x(), robotPose.y(), robotPose.z()),
 		gam::GridLattice{getXMin(), getYMin(), getResolution()});
+	if (m_options.mount.enabled)
+	{
+		// The floor in the sensor's own frame says where the sensor is: compare
+		// with the declared mount (whatever pose placed the points).
+		std::optional<gam::SensorMount> measured;
+		const gam::GroundDetection& det = m_pipeline.result().detection;
+		if (det.ok() && !det.planes.empty())
+		{
+			const mrpt::poses::CPose3D w = robotPose + used;
+			Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+			T.linear() = w.getRotationMatrix().asEigen();
+			T.translation() = Eigen::Vector3d(w.x(), w.y(), w.z());
+			// The sensor's distance to the floor is its height (the robot's
+			// origin is on the floor, so the declared z is a height too).
+			measured = gam::mountFromFloor(gam::planeInSensorFrame(det.plane(), T));
+		}
+		mon->second.update({declared.z(), declared.pitch(), declared.roll()}, measured);
+	}
 	const auto t1 = clk::now();
 	applyEvidence();
 	const auto t2 = clk::now();

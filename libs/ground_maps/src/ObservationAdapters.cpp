@@ -55,14 +55,11 @@ size_t binPointCloud(
 	return binPoints(xs.data(), ys.data(), zs.data(), pts.size(), toRigid(pose), f, grid, out);
 }
 
-namespace
-{
 void placeSensor(const mrpt::poses::CPose3D& sensorInMap, SensorFrame& out)
 {
 	out.sensor_to_map = toRigid(sensorInMap);
 	out.sensor_position = Eigen::Vector3d(sensorInMap.x(), sensorInMap.y(), sensorInMap.z());
 }
-}  // namespace
 
 bool toSensorFrame(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose, SensorFrame& out)
 {

@@ -9,6 +9,7 @@
 #include <mrpt/maps/TMetricMapInitializer.h>
 
 #include <csignal>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -63,6 +64,12 @@ void loadMapDefinitions(
 	mrpt::maps::TSetOfMetricMapInitializers& inits, std::vector<MapSpec>& specs,
 	std::vector<std::string>* warnings = nullptr);
 
+/** The [sensor_poses] section: `LABEL = x y z yaw pitch roll` (metres,
+ * degrees) per sensor label; the mapper gives those observations this
+ * sensorPose instead of the rawlog's. Throws ConfigError for a malformed entry. */
+std::map<std::string, mrpt::poses::CPose3D> readSensorPoses(
+	const mrpt::config::CConfigFileBase& ini, const std::string& configName);
+
 struct MapTiming
 {
 	std::string label, className;
@@ -79,6 +86,7 @@ struct RunSummary
 	double seconds = 0;
 	std::vector<MapTiming> maps;
 	std::vector<std::string> files;  ///< written, relative to outDir
+	std::vector<std::string> notes;  ///< per-map remarks (e.g. the sensor mount check)
 	std::string text() const;
 };
 
@@ -104,6 +112,9 @@ class Mapper
 	std::vector<MapSpec> m_specs;
 	std::vector<std::string> m_warnings;
 	mrpt::poses::CPose3D m_lastPose;
+	/** [sensor_poses] of the .ini: sensorPose per sensor label, replacing the
+	 * rawlog's (gam-calibrate --write-ini writes it). */
+	std::map<std::string, mrpt::poses::CPose3D> m_sensorPoses;
 };
 
 }  // namespace gam::mapper

@@ -42,6 +42,10 @@ struct GroundPlaneRecord
 	double a = 0, b = 0, c = 0, d = 0;  ///< a x + b y + c z + d = 0
 	size_t nodes = 0;
 	std::string status;
+	/** The sensor mount this frame's floor says (see gam::MountMonitor). */
+	bool mount_measured = false;
+	double mount_z = 0, mount_pitch_deg = 0, mount_roll_deg = 0;
+	bool mount_alarm = false;
 };
 
 using StageSink = std::function<void(const char* stage, double ms)>;
@@ -62,6 +66,8 @@ struct MapTraits
 	std::function<void(const mrpt::maps::CMetricMap& map, bool depthFrame, const StageSink& sink)> stageTimes;
 	/** After a depth frame: its ground plane, if the class finds one. */
 	std::function<bool(const mrpt::maps::CMetricMap& map, GroundPlaneRecord& out)> lastGroundPlane;
+	/** After a run: lines for the mapper's summary (empty: nothing to say). */
+	std::function<std::string(const mrpt::maps::CMetricMap& map)> runNote;
 	/** Local-map mode: keep only an n x n cell window centred on (x, y). */
 	std::function<void(mrpt::maps::CMetricMap& map, double x, double y, int cells)> keepWindow;
 };

@@ -31,6 +31,10 @@ PinholeIntrinsics intrinsicsOf(const mrpt::obs::CObservation3DRangeScan& o);
  * non-finite poses and malformed observations. */
 bool toSensorFrame(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose, SensorFrame& out);
 
+/** Places `out`'s sensor at `sensorInMap` (the robot pose composed with a
+ * sensor pose on the robot), e.g. a measured mount instead of the declared one. */
+void placeSensor(const mrpt::poses::CPose3D& sensorInMap, SensorFrame& out);
+
 /** Bins any supported observation taken from `robotPose` into `grid` bins:
  * what toSensorFrame() adapts, and CObservation2DRangeScan. Heights are in the
  * grid (map) frame. Returns false if the class is not supported; throws

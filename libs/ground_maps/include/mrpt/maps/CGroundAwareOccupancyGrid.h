@@ -1,10 +1,14 @@
 // Ground-aware mapping for MRPT
 #pragma once
 
+#include <map>
+#include <string>
+
 #include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 
 #include "gam/core/GroundAwarePipeline.h"
+#include "gam/core/SensorMount.h"
 
 namespace mrpt::obs
 {
@@ -65,6 +69,9 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		 * on, 2D scans add their hits and make no cell freer: only floor the
 		 * depth camera saw is free (off: MRPT's beam model). */
 		bool scan_keeps_3d_obstacles = true;
+		/** The online check of the declared sensor mount (height, pitch, roll)
+		 * against every frame's floor, and the option to map with the measured one. */
+		gam::MountCheckParams mount;
 
 		/** Every `_groundOpts` key: the pipeline's, then the 2D-scan ones. */
 		template <class Self, class Visit>
@@ -77,6 +84,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 			visit(
 				gam::ParamInfo{"scan_keeps_3d_obstacles", 0, 1, "2D scans add their hits and free no cell"},
 				o.scan_keeps_3d_obstacles);
+			gam::MountCheckParams::forEachParam(o.mount, visit);
 		}
 		/** Loads and validates (throws std::invalid_argument naming the key). */
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
@@ -99,6 +107,14 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	/** What happened to the last 3D frame (for apps, viewers and logs). */
 	const gam::FrameResult& lastFrame() const { return m_pipeline.result(); }
 	const TFrameTimes& lastFrameTimes() const { return m_times; }
+	/** The mount check per sensor label (gam::MountMonitor): the declared and
+	 * the measured height, pitch and roll, the counters and the alarm. */
+	const std::map<std::string, gam::MountMonitor>& mountChecks() const { return m_mounts; }
+	/** True while the mount alarm of any sensor is on. */
+	bool mountAlarm() const;
+	/** The label of the last depth frame's sensor (its entry in mountChecks()). */
+	const std::string& lastSensorLabel() const { return m_lastSensorLabel; }
+
 	/** The 2.5D map of the last 3D frame. */
 	const gam::ElevationGrid& lastFrameElevation() const { return m_pipeline.frameGrid(); }
 	/** The ISM evidence and voxel classes of the last 3D frame (frame grid). */
@@ -133,6 +149,8 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	// The method and its per-frame workspace (not serialized).
 	gam::GroundAwarePipeline m_pipeline;
 	TFrameTimes m_times;
+	std::map<std::string, gam::MountMonitor> m_mounts;  // not serialized: state of a run
+	std::string m_lastSensorLabel;
 };
 
 }  // namespace mrpt::maps

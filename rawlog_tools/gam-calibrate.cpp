@@ -1,0 +1,250 @@
+// Ground-aware mapping for MRPT -- gam-calibrate: the camera mount measured
+// from the floor (issue #15). For each depth camera of a rawlog, every frame's
+// ground plane (RRT-GPD + RANSAC, as CGroundAwareOccupancyGrid finds it) gives
+// the sensor's height above the floor, its pitch and its roll; frames whose
+// plane disagrees with the others are rejected; the rest give the estimate.
+//
+// usage: gam-calibrate --rawlog FILE [--label CAM] [--config FILE.ini] [--write-ini FILE.ini]
+// prints one line per camera:
+//   CAM z=<m> pitch=<deg> roll=<deg> (+-<m>, +-<deg>, +-<deg>) frames=<used>/<total>
+// (the +- are the standard errors of the means over the frames used), then
+// the declared sensorPose for comparison. MRPT's yaw/pitch/roll convention.
+// x, y and yaw are not observable from a floor: --write-ini keeps the
+// declared ones and writes `CAM = x y z yaw pitch roll` into the file's
+// [sensor_poses] section, which ground-aware-mapper applies to the
+// observations of that label.
+// exit: 0 ok, 1 bad input or no estimate, 2 command line.
+#include <mrpt/3rdparty/tclap/CmdLine.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/maps/CGroundAwareOccupancyGrid.h>
+#include <mrpt/maps/CMultiMetricMap.h>
+#include <mrpt/maps/registerBaselineMaps.h>
+#include <mrpt/maps/registerGroundAwareMaps.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "gam/mapper/Mapper.h"
+#include "gam/mapper/RawlogFrames.h"
+
+using mrpt::maps::CGroundAwareOccupancyGrid;
+
+namespace
+{
+struct Failure : std::runtime_error
+{
+	using std::runtime_error::runtime_error;
+};
+
+/** Keeps TCLAP's parse error for a one-line message instead of its usage dump. */
+class QuietFailureOutput : public TCLAP::StdOutput
+{
+   public:
+	std::string error;
+	void failure(TCLAP::CmdLineInterface&, TCLAP::ArgException& e) override { error = e.argId() + ": " + e.error(); }
+};
+
+std::string readText(const std::string& path)
+{
+	std::ifstream f(path);
+	if (!f) throw Failure("cannot read " + path);
+	return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+/** The ground-aware grid of the mapper's .ini (its plane detection settings). */
+CGroundAwareOccupancyGrid gridFromConfig(const mrpt::config::CConfigFileBase& ini, const std::string& path)
+{
+	mrpt::maps::TSetOfMetricMapInitializers inits;
+	std::vector<gam::mapper::MapSpec> specs;
+	gam::mapper::loadMapDefinitions(ini, "map", inits, specs);
+	mrpt::maps::CMultiMetricMap mm;
+	mm.setListOfMaps(inits);
+	const auto ga = mm.mapByClass<CGroundAwareOccupancyGrid>();
+	if (!ga) throw Failure(path + " defines no groundAwareGrid (its plane detection settings are needed)");
+	return *ga;
+}
+
+struct Camera
+{
+	std::vector<gam::SensorMount> perFrame;
+	size_t frames = 0;
+	mrpt::poses::CPose3D declared;
+};
+
+/** Writes `label = x y z yaw pitch roll` into [sensor_poses] of `path`,
+ * keeping the rest of the file (created if missing). */
+void writeSensorPose(const std::string& path, const std::string& label, const mrpt::poses::CPose3D& p)
+{
+	std::vector<std::string> lines;
+	{
+		std::ifstream f(path);
+		std::string l;
+		while (f && std::getline(f, l)) lines.push_back(l);
+	}
+	char value[256];
+	const double k = 180.0 / M_PI;
+	std::snprintf(
+		value, sizeof value, "%s = %.4f %.4f %.4f %.3f %.3f %.3f  ; x y z [m] yaw pitch roll [deg], gam-calibrate",
+		label.c_str(), p.x(), p.y(), p.z(), p.yaw() * k, p.pitch() * k, p.roll() * k);
+	auto trim = [](std::string s) {
+		s.erase(0, s.find_first_not_of(" \t"));
+		s.erase(s.find_last_not_of(" \t\r") + 1);
+		return s;
+	};
+	int section = -1, end = int(lines.size());
+	for (int i = 0; i < int(lines.size()); i++)
+	{
+		const std::string t = trim(lines[size_t(i)]);
+		if (t.size() > 1 && t.front() == '[')
+		{
+			if (section >= 0 && i > section)
+			{
+				end = i;
+				break;
+			}
+			if (t == "[sensor_poses]") section = i;
+		}
+	}
+	if (section < 0)
+	{
+		if (!lines.empty() && !trim(lines.back()).empty()) lines.push_back("");
+		lines.push_back("[sensor_poses]");
+		lines.push_back("# sensorPose per sensor label, applied by ground-aware-mapper in place of the rawlog's");
+		lines.push_back(value);
+	}
+	else
+	{
+		bool replaced = false;
+		for (int i = section + 1; i < end; i++)
+		{
+			const std::string t = trim(lines[size_t(i)]);
+			const auto eq = t.find('=');
+			if (eq != std::string::npos && trim(t.substr(0, eq)) == label)
+			{
+				lines[size_t(i)] = value;
+				replaced = true;
+			}
+		}
+		if (!replaced) lines.insert(lines.begin() + end, value);
+	}
+	std::ofstream f(path);
+	for (const auto& l : lines) f << l << "\n";
+	if (!f) throw Failure("cannot write " + path);
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+	try
+	{
+		TCLAP::CmdLine cmd(
+			"gam-calibrate: height, pitch and roll of each depth camera measured from the floor", ' ', "1.0");
+		TCLAP::ValueArg<std::string> argRawlog("", "rawlog", "rawlog with depth frames", true, "", "FILE", cmd);
+		TCLAP::ValueArg<std::string> argLabel("", "label", "only this camera (sensorLabel)", false, "", "CAM", cmd);
+		TCLAP::ValueArg<std::string> argConfig(
+			"", "config", "the mapper's .ini (plane detection settings, [sensor_poses]); default: built-in defaults",
+			false, "", "FILE", cmd);
+		TCLAP::ValueArg<std::string> argWrite(
+			"", "write-ini", "write the measured poses into [sensor_poses] of this .ini", false, "", "FILE", cmd);
+		QuietFailureOutput quiet;
+		cmd.setOutput(&quiet);
+		if (!cmd.parse(argc, argv))
+		{
+			if (quiet.error.empty()) return 0;
+			std::cerr << "gam-calibrate: error: " << quiet.error << " (see --help)\n";
+			return 2;
+		}
+
+		// The mapper's .ini may define the comparison maps too: know their kinds.
+		mrpt::maps::registerGroundAwareMaps();
+		mrpt::maps::registerBaselineMaps();
+		CGroundAwareOccupancyGrid base;
+		std::map<std::string, mrpt::poses::CPose3D> overrides;
+		if (!argConfig.getValue().empty())
+		{
+			const mrpt::config::CConfigFileMemory ini(readText(argConfig.getValue()));
+			base = gridFromConfig(ini, argConfig.getValue());
+			overrides = gam::mapper::readSensorPoses(ini, argConfig.getValue());
+		}
+		// Collect every frame's measurement; the map's own check is not used
+		// for the decision, only its per-frame value.
+		auto opts = base.groundOptions();
+		opts.mount.enabled = true;
+		opts.mount.use_measured = false;
+		base.setGroundOptions(opts);
+
+		std::map<std::string, Camera> cams;
+		std::map<std::string, CGroundAwareOccupancyGrid> grids;  // one per camera
+		gam::mapper::RawlogFrameReader reader(argRawlog.getValue());
+		gam::mapper::Frame fr;
+		size_t n = 0;
+		while (reader.next(fr))
+		{
+			const auto* o3 = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(fr.obs.get());
+			if (!o3) continue;
+			const std::string& label = fr.obs->sensorLabel;
+			if (!argLabel.getValue().empty() && label != argLabel.getValue()) continue;
+			if (const auto it = overrides.find(label); it != overrides.end()) fr.obs->setSensorPose(it->second);
+			auto g = grids.find(label);
+			if (g == grids.end()) g = grids.emplace(label, base).first;
+			Camera& cam = cams[label];
+			cam.frames++;
+			fr.obs->getSensorPose(cam.declared);
+			const size_t before =
+				g->second.mountChecks().count(label) ? g->second.mountChecks().at(label).status().frames_checked : 0;
+			// A fresh grid per frame would also do: only the plane of this frame counts.
+			g->second.insertObservation(*fr.obs, fr.robotPose);
+			const gam::MountStatus& s = g->second.mountChecks().at(label).status();
+			if (s.frames_checked > before) cam.perFrame.push_back(s.last);
+			if (++n % 50 == 0) std::cerr << "gam-calibrate: " << n << " depth frames\n";
+		}
+		if (cams.empty())
+			throw Failure(
+				"no CObservation3DRangeScan" +
+				(argLabel.getValue().empty() ? std::string() : " labelled '" + argLabel.getValue() + "'") + " in " +
+				argRawlog.getValue());
+
+		int status = 0;
+		const double k = 180.0 / M_PI;
+		for (const auto& [label, cam] : cams)
+		{
+			const gam::MountEstimate e = gam::estimateMount(cam.perFrame);
+			if (!e.used)
+			{
+				std::cout << label << " no estimate: no frame had a floor plane (" << cam.frames << " frames)\n";
+				status = 1;
+				continue;
+			}
+			std::printf(
+				"%s z=%.4f pitch=%.3f roll=%.3f (+-%.4f, +-%.3f, +-%.3f) frames=%zu/%zu\n", label.c_str(),
+				e.mean.height, e.mean.pitch * k, e.mean.roll * k, e.standard_error.height, e.standard_error.pitch * k,
+				e.standard_error.roll * k, e.used, cam.frames);
+			std::printf(
+				"  declared sensorPose: z=%.4f pitch=%.3f roll=%.3f (x=%.4f y=%.4f yaw=%.3f kept: not observable from "
+				"the floor); %zu frames had a floor plane, %zu rejected\n",
+				cam.declared.z(), cam.declared.pitch() * k, cam.declared.roll() * k, cam.declared.x(), cam.declared.y(),
+				cam.declared.yaw() * k, cam.perFrame.size(), cam.perFrame.size() - e.used);
+			if (!argWrite.getValue().empty())
+			{
+				const mrpt::poses::CPose3D p(
+					cam.declared.x(), cam.declared.y(), e.mean.height, cam.declared.yaw(), e.mean.pitch, e.mean.roll);
+				writeSensorPose(argWrite.getValue(), label, p);
+				std::printf("  written to [sensor_poses] of %s\n", argWrite.getValue().c_str());
+			}
+		}
+		return status;
+	}
+	catch (const std::exception& e)
+	{
+		std::cerr << "gam-calibrate: error: " << e.what() << "\n";
+		return 1;
+	}
+}
