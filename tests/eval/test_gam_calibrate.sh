@@ -13,6 +13,10 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 
 bash "$repo/rawlog_tools/gam-calibration-check" --build "$build" --frames 8 \
 	--cases "0.55,12,-6,0.08,4,-4 0.95,32,5,-0.06,-3,3" || fail "calibration check"
+# The robot standing still: ten frames from one pose.
+sed 's/^path .*/path waypoints=0,0,0 frames=10/' "$repo/config/scenes/demo.scene" >"$w/standing.scene"
+bash "$repo/rawlog_tools/gam-calibration-check" --build "$build" --scene "$w/standing.scene" --frames 10 \
+	--cases "0.7,18,-5,-0.09,4,3" || fail "calibration check, standing"
 
 "$build/rawlog_tools/gam-simulate" --scene "$repo/config/scenes/demo.scene" --out "$w/d" --frames 6 \
 	--declared-offset 0.05,2,0 >/dev/null
