@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# gam-calibrate (issue #15): two simulated mounts with a wrong declared pose
+# gam-calibrate (issue #15): three simulated mounts with a wrong declared pose
 # are measured within 1 cm / 0.3 deg and raise the mapper's alarm within 10
-# depth frames (gam-calibration-check); --write-ini writes one [sensor_poses]
+# depth frames (gam-calibration-check), driving and standing; --write-ini writes one [sensor_poses]
 # line per camera and replaces it on the next run; bad input: one error line, exit 1.
 # usage: test_gam_calibrate.sh BUILD_DIR REPO
 set -euo pipefail
