@@ -14,6 +14,8 @@
 // [sensor_poses] section, which ground-aware-mapper applies to the
 // observations of that label.
 // exit: 0 ok, 1 bad input or no estimate, 2 command line.
+#include <gam/common/CommandLine.h>
+#include <gam/common/Version.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
@@ -42,14 +44,6 @@ namespace
 struct Failure : std::runtime_error
 {
 	using std::runtime_error::runtime_error;
-};
-
-/** Keeps TCLAP's parse error for a one-line message instead of its usage dump. */
-class QuietFailureOutput : public TCLAP::StdOutput
-{
-   public:
-	std::string error;
-	void failure(TCLAP::CmdLineInterface&, TCLAP::ArgException& e) override { error = e.argId() + ": " + e.error(); }
 };
 
 std::string readText(const std::string& path)
@@ -146,7 +140,7 @@ int main(int argc, char** argv)
 	try
 	{
 		TCLAP::CmdLine cmd(
-			"gam-calibrate: height, pitch and roll of each depth camera measured from the floor", ' ', "1.0");
+			"gam-calibrate: height, pitch and roll of each depth camera measured from the floor", ' ', GAM_VERSION);
 		TCLAP::ValueArg<std::string> argRawlog("", "rawlog", "rawlog with depth frames", true, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> argLabel("", "label", "only this camera (sensorLabel)", false, "", "CAM", cmd);
 		TCLAP::ValueArg<std::string> argConfig(
@@ -154,14 +148,7 @@ int main(int argc, char** argv)
 			false, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> argWrite(
 			"", "write-ini", "write the measured poses into [sensor_poses] of this .ini", false, "", "FILE", cmd);
-		QuietFailureOutput quiet;
-		cmd.setOutput(&quiet);
-		if (!cmd.parse(argc, argv))
-		{
-			if (quiet.error.empty()) return 0;
-			std::cerr << "gam-calibrate: error: " << quiet.error << " (see --help)\n";
-			return 2;
-		}
+		if (const int rc = gam::parseCommandLine(cmd, argc, argv, "gam-calibrate"); rc >= 0) return rc;
 
 		// The mapper's .ini may define the comparison maps too: know their kinds.
 		mrpt::maps::registerGroundAwareMaps();

@@ -6,6 +6,8 @@
 //                     --gt PREFIX [--json FILE] [--csv FILE] [--png FILE]
 //                     [--tolerance-cells 1] [--min-hits 1] [--title TEXT]
 // exit: 0 ok, 1 missing or bad input / unwritable output, 2 command line.
+#include <gam/common/CommandLine.h>
+#include <gam/common/Version.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/img/CImage.h>
 
@@ -20,19 +22,6 @@ using namespace gam::eval;
 
 namespace
 {
-/** Keeps TCLAP's parse error for a one-line message instead of its usage dump. */
-class QuietFailureOutput : public TCLAP::StdOutput
-{
-   public:
-	std::string error;
-	void failure(TCLAP::CmdLineInterface&, TCLAP::ArgException& e) override
-	{
-		error = e.argId() + ": " + e.error();
-		for (auto& c : error)
-			if (c == '\n' || c == '\r') c = ' ';
-	}
-};
-
 void writeText(const std::string& path, const std::string& text)
 {
 	std::ofstream f(path);
@@ -96,7 +85,7 @@ int main(int argc, char** argv)
 	TCLAP::CmdLine cmd(
 		"gam-evaluate: scores ROS map_server maps against gam-simulate ground truth "
 		"(per-object detection by category, floor false obstacles, floor free)",
-		' ', "1.0");
+		' ', GAM_VERSION);
 	TCLAP::MultiArg<std::string> argMap(
 		"m", "map", "map yaml (ROS map_server); repeat for several maps", true, "YAML", cmd);
 	TCLAP::ValueArg<std::string> argGt(
@@ -115,14 +104,7 @@ int main(int argc, char** argv)
 	TCLAP::ValueArg<int> argHits(
 		"", "min-hits", "occupied cells an object needs to be detected (default 1)", false, 1, "N", cmd);
 	TCLAP::SwitchArg argQuiet("q", "quiet", "no table on stdout", cmd);
-	QuietFailureOutput out;
-	cmd.setOutput(&out);
-	if (!cmd.parse(argc, argv))
-	{
-		if (out.error.empty()) return 0;  // --help / --version
-		std::cerr << "gam-evaluate: error: " << out.error << " (see --help)\n";
-		return 2;
-	}
+	if (const int rc = gam::parseCommandLine(cmd, argc, argv, "gam-evaluate"); rc >= 0) return rc;
 	Options opt;
 	opt.tolerance_cells = argTol.getValue();
 	opt.min_hits = argHits.getValue();

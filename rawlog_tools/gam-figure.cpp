@@ -13,6 +13,8 @@
 // The 2D columns of Fig. 4 are the paper's method (ism_model = rrt_variant =
 // paper); "3-sigma + IDW" feeds the IDW cells to the ISM (idw_in_ism = 1).
 // exit: 0 ok, 1 bad input or unwritable output, 2 command line.
+#include <gam/common/CommandLine.h>
+#include <gam/common/Version.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/img/CImage.h>
@@ -53,14 +55,6 @@ namespace
 struct Failure : std::runtime_error
 {
 	using std::runtime_error::runtime_error;
-};
-
-/** Keeps TCLAP's parse error for a one-line message instead of its usage dump. */
-class QuietFailureOutput : public TCLAP::StdOutput
-{
-   public:
-	std::string error;
-	void failure(TCLAP::CmdLineInterface&, TCLAP::ArgException& e) override { error = e.argId() + ": " + e.error(); }
 };
 
 struct Frame
@@ -442,7 +436,7 @@ int main(int argc, char** argv)
 {
 	try
 	{
-		TCLAP::CmdLine cmd("gam-figure: the paper's Fig. 4 and Fig. 5, reproduced (issue #12)", ' ', "1.0");
+		TCLAP::CmdLine cmd("gam-figure: the paper's Fig. 4 and Fig. 5, reproduced (issue #12)", ' ', GAM_VERSION);
 		TCLAP::ValueArg<int> argFig("", "figure", "4 or 5", true, 4, "N", cmd);
 		TCLAP::MultiArg<std::string> argRawlog(
 			"", "rawlog", "simulated rawlog (Fig. 4: one per row)", true, "FILE", cmd);
@@ -454,14 +448,7 @@ int main(int argc, char** argv)
 			"", "config", "the mapper's .ini (its groundAwareGrid and heightBandGrid)", false,
 			"config/ground-aware-mapper.ini", "FILE", cmd);
 		TCLAP::ValueArg<int> argCells("", "cells", "Fig. 5: side of the local map in cells", false, 600, "N", cmd);
-		QuietFailureOutput quiet;
-		cmd.setOutput(&quiet);
-		if (!cmd.parse(argc, argv))
-		{
-			if (quiet.error.empty()) return 0;  // --help / --version
-			std::cerr << "gam-figure: error: " << quiet.error << " (see --help)\n";
-			return 2;
-		}
+		if (const int rc = gam::parseCommandLine(cmd, argc, argv, "gam-figure"); rc >= 0) return rc;
 		std::vector<Row> rows;
 		const ConfiguredMaps cfg = loadConfig(argConfig.getValue());
 		if (argFig.getValue() == 4)

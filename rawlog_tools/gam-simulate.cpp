@@ -6,6 +6,8 @@
 //                     [--frames N] [--no-leddar] [--depth-images]
 // outputs: PREFIX.rawlog, PREFIX_gt.pgm, PREFIX_gt.yaml, PREFIX_gt_objects.csv,
 //          PREFIX_gt_labels.csv, PREFIX_gt_path.csv
+#include <gam/common/CommandLine.h>
+#include <gam/common/Version.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/core/Clock.h>
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -121,7 +123,7 @@ int main(int argc, char** argv)
 {
 	try
 	{
-		TCLAP::CmdLine cmd("gam-simulate", ' ', "0.1");
+		TCLAP::CmdLine cmd("gam-simulate", ' ', GAM_VERSION);
 		TCLAP::ValueArg<std::string> argScene("", "scene", "scene file (.scene)", true, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> argOut("", "out", "output prefix", true, "", "PREFIX", cmd);
 		TCLAP::ValueArg<unsigned> argSeed("", "seed", "random seed (default 1)", false, 1, "N", cmd);
@@ -140,7 +142,7 @@ int main(int argc, char** argv)
 			false, "", "DZ,DPITCH,DROLL", cmd);
 		TCLAP::SwitchArg argDepthPgm(
 			"", "depth-images", "also write PREFIX_depth_NNNN.pgm (16-bit, millimetres) per frame", cmd);
-		cmd.parse(argc, argv);
+		if (const int rc = gam::parseCommandLine(cmd, argc, argv, "gam-simulate"); rc >= 0) return rc;
 
 		const auto t0 = std::chrono::steady_clock::now();
 		SceneFile sf;

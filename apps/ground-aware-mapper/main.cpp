@@ -1,6 +1,8 @@
 // ground-aware-mapper: builds the ground-aware grid and the comparison maps
 // from a rawlog. All the work is in libs/ground_mapper (gam::mapper::Mapper).
 #include <default_config.h>
+#include <gam/common/CommandLine.h>
+#include <gam/common/Version.h>
 #include <gam/mapper/Errors.h>
 #include <gam/mapper/Mapper.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -18,14 +20,6 @@ constexpr const char* kApp = "ground-aware-mapper";
 
 volatile std::sig_atomic_t gStop = 0;
 extern "C" void onSignal(int) { gStop = 1; }
-
-/** Keeps TCLAP's parse error for our one-line message instead of its usage dump. */
-class QuietFailureOutput : public TCLAP::StdOutput
-{
-   public:
-	std::string error;
-	void failure(TCLAP::CmdLineInterface&, TCLAP::ArgException& e) override { error = e.argId() + ": " + e.error(); }
-};
 
 int fail(int code, std::string msg)
 {
@@ -48,7 +42,7 @@ int main(int argc, char** argv)
 			"Ground-aware 2D occupancy mapping from a rawlog (depth cameras, 2D scans). Writes, for every "
 			"2D grid of the .ini, <label>.yaml/.pgm (ROS map_server), <label>.gridmap.gz and <label>.png, "
 			"plus the elevation map, ground_planes.csv and timing.csv into --out.",
-			' ', "0.1.0");
+			' ', GAM_VERSION);
 		TCLAP::ValueArg<std::string> aRawlog(
 			"r", "rawlog", "input rawlog (either format)", false, "", "FILE.rawlog", cmd);
 		TCLAP::ValueArg<std::string> aOut("o", "out", "output directory (created if missing)", false, "", "DIR", cmd);
@@ -64,13 +58,7 @@ int main(int argc, char** argv)
 			"", "local-size-cells", "side of the local window in cells (with --local-map)", false, 600, "N", cmd);
 		TCLAP::ValueArg<long> aMaxFrames("n", "max-frames", "stop after N frames (0 = all)", false, 0, "N", cmd);
 		TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line on stderr", cmd);
-		QuietFailureOutput out;
-		cmd.setOutput(&out);
-		if (!cmd.parse(argc, argv))
-		{
-			if (!out.error.empty()) return fail(2, out.error + " (see --help)");
-			return 0;  // --help / --version
-		}
+		if (const int rc = gam::parseCommandLine(cmd, argc, argv, "ground-aware-mapper"); rc >= 0) return rc;
 
 		if (aPrint.getValue())
 		{

@@ -8,6 +8,8 @@
 // usage: ground-aware-nav-example [--scene config/scenes/nav_hole.scene]
 //            [--start 0,0] [--goal 4.5,0] [--robot-radius 0.3] [--out DIR]
 //            [--no-noise] [--seed N] [--no-reactive] [--reactive-config FILE]
+#include <gam/common/CommandLine.h>
+#include <gam/common/Version.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 
 #include <cstdio>
@@ -34,7 +36,7 @@ int main(int argc, char** argv)
 {
 	try
 	{
-		TCLAP::CmdLine cmd("ground-aware-nav-example", ' ', "0.1");
+		TCLAP::CmdLine cmd("ground-aware-nav-example", ' ', GAM_VERSION);
 		TCLAP::ValueArg<std::string> argScene(
 			"", "scene", "scene file", false, "config/scenes/nav_hole.scene", "FILE", cmd);
 		TCLAP::ValueArg<std::string> argStart("", "start", "start X,Y [m]", false, "0,0", "X,Y", cmd);
@@ -48,7 +50,7 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<std::string> argReactiveCfg(
 			"", "reactive-config", "base reactive navigator .ini", false, gam::nav::ReactiveOptions{}.baseConfig,
 			"FILE", cmd);
-		cmd.parse(argc, argv);
+		if (const int rc = gam::parseCommandLine(cmd, argc, argv, "ground-aware-nav-example"); rc >= 0) return rc;
 
 		const auto sf = gam::sim::parseSceneFile(argScene.getValue());
 		const auto start = parseXY(argStart.getValue(), "--start");

@@ -9,6 +9,8 @@
 //            [--width 800 --height 600]
 // Batch mode (--screenshot-dir DIR --exit) renders every view off-screen with
 // CFBORender into DIR/<view>.png and exits: no display needed.
+#include <gam/common/CommandLine.h>
+#include <gam/common/Version.h>
 #include <gam/maps/IniFields.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
 #include <mrpt/gui/CWxGLCanvasBase.h>
@@ -468,7 +470,7 @@ int main(int argc, char** argv)
 	mrpt::maps::registerBaselineMaps();
 	try
 	{
-		TCLAP::CmdLine cmd("ground-aware-viewer", ' ', "0.1");
+		TCLAP::CmdLine cmd("ground-aware-viewer", ' ', GAM_VERSION);
 		TCLAP::UnlabeledValueArg<std::string> argFile("file", "rawlog", false, "", "FILE.rawlog", cmd);
 		TCLAP::ValueArg<std::string> argRawlog("r", "rawlog", "rawlog to open", false, "", "FILE", cmd);
 		TCLAP::ValueArg<std::string> argConfig(
@@ -487,7 +489,7 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<std::string> argGuiShot(
 			"", "gui-snapshot", "(self-check) open the GUI, edit K, save the window to FILE.png and quit", false, "",
 			"FILE", cmd);
-		cmd.parse(argc, argv);
+		if (const int rc = gam::parseCommandLine(cmd, argc, argv, "ground-aware-viewer"); rc >= 0) return rc;
 		Args a;
 		a.rawlog = argRawlog.isSet() ? argRawlog.getValue() : argFile.getValue();
 		a.config = argConfig.getValue();
