@@ -12,6 +12,7 @@
 #include <mrpt/img/CImage.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -30,7 +31,24 @@ void writeText(const std::string& path, const std::string& text)
 	if (!f) throw Error("cannot write " + path);
 }
 
-/** GT panel + one panel per map, all on the GT grid (+y up), cells scaled up. */
+/** The robot's path of gam-simulate (PREFIX_gt_path.csv: frame,timestamp,x,y,...);
+ * empty if there is none. */
+std::vector<std::pair<double, double>> loadPath(const std::string& prefix)
+{
+	std::vector<std::pair<double, double>> path;
+	std::ifstream f(prefix + "_gt_path.csv");
+	std::string line;
+	if (!std::getline(f, line)) return path;
+	while (std::getline(f, line))
+	{
+		double fr, ts, x, y;
+		if (std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &fr, &ts, &x, &y) == 4) path.emplace_back(x, y);
+	}
+	return path;
+}
+
+/** GT panel + one panel per map, all on the GT grid (+y up), cells scaled up;
+ * the robot's path on every panel, a 1 m scale bar and a legend. */
 void writePng(
 	const std::string& path, const std::string& title, const GroundTruth& gt, const std::vector<RosMap>& maps,
 	const std::vector<MapScore>& scores)
@@ -40,7 +58,10 @@ void writePng(
 	const int pw = gt.nx * k, ph = gt.ny * k, gap = 8, top = 20, label = 16;
 	const int n = 1 + int(maps.size());
 	const int cols = (n * (pw + gap) > 1600 && n > 2) ? (n + 1) / 2 : n, rows = (n + cols - 1) / cols;
-	mrpt::img::CImage im(cols * pw + (cols + 1) * gap, top + rows * (ph + label + gap), mrpt::img::CH_RGB);
+	const int legendH = 22;
+	mrpt::img::CImage im(cols * pw + (cols + 1) * gap, top + rows * (ph + label + gap) + legendH, mrpt::img::CH_RGB);
+	const auto robotPath = loadPath(gt.prefix);
+	const double gxmin = gt.x[0] - 0.5 * gt.resolution, gymin = gt.y[0] - 0.5 * gt.resolution;
 	im.filledRectangle(0, 0, int(im.getWidth()) - 1, int(im.getHeight()) - 1, TColor(255, 255, 255));
 	const TColor unknown(190, 205, 235);
 	auto panel = [&](int p, const std::string& name, auto colourOf) {
@@ -54,6 +75,21 @@ void writePng(
 				const int px = x0 + ix * k, py = y0 + (gt.ny - 1 - iy) * k;
 				im.filledRectangle(px, py, px + k - 1, py + k - 1, c);
 			}
+		// The robot's path (red) and a 1 m scale bar in the lower left corner.
+		auto toPx = [&](double x, double y) {
+			return std::pair<int, int>(
+				x0 + int(std::lround((x - gxmin) / gt.resolution * k)),
+				y0 + int(std::lround((gt.ny - (y - gymin) / gt.resolution) * k)));
+		};
+		for (size_t i = 1; i < robotPath.size(); i++)
+		{
+			const auto a = toPx(robotPath[i - 1].first, robotPath[i - 1].second);
+			const auto b = toPx(robotPath[i].first, robotPath[i].second);
+			im.line(a.first, a.second, b.first, b.second, TColor(220, 0, 0), 2);
+		}
+		const int bar = int(std::lround(1.0 / gt.resolution * k)), bx = x0 + 6, by = y0 + ph - 8;
+		im.filledRectangle(bx, by, bx + bar, by + 3, TColor(0, 90, 200));
+		im.textOut(bx, by - 12, "1 m", TColor(0, 90, 200));
 	};
 	panel(0, "ground truth", [&](size_t i) {
 		switch (gt.label[i])
@@ -76,6 +112,23 @@ void writePng(
 		});
 	}
 	if (!title.empty()) im.textOut(gap, 3, title, TColor(60, 60, 60));
+	// Legend.
+	{
+		int x = gap;
+		const int y = int(im.getHeight()) - legendH + 4;
+		auto swatch = [&](const TColor& c, const std::string& text) {
+			im.filledRectangle(x, y, x + 12, y + 12, c);
+			im.rectangle(x, y, x + 12, y + 12, TColor(120, 120, 120));
+			im.textOut(x + 16, y + 2, text, TColor(0, 0, 0));
+			x += 16 + 9 * int(text.size()) + 18;
+		};
+		swatch(TColor(255, 255, 255), "free");
+		swatch(TColor(0, 0, 0), "occupied");
+		swatch(unknown, "unknown");
+		swatch(TColor(200, 30, 30), "GT drop / hole");
+		im.line(x, y + 6, x + 14, y + 6, TColor(220, 0, 0), 2);
+		im.textOut(x + 18, y + 2, "robot path", TColor(0, 0, 0));
+	}
 	if (!im.saveToFile(path)) throw Error("cannot write " + path);
 }
 }  // namespace
