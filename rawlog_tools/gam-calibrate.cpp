@@ -56,11 +56,8 @@ std::string readText(const std::string& path)
 /** The ground-aware grid of the mapper's .ini (its plane detection settings). */
 CGroundAwareOccupancyGrid gridFromConfig(const mrpt::config::CConfigFileBase& ini, const std::string& path)
 {
-	mrpt::maps::TSetOfMetricMapInitializers inits;
-	std::vector<gam::mapper::MapSpec> specs;
-	gam::mapper::loadMapDefinitions(ini, "map", inits, specs);
 	mrpt::maps::CMultiMetricMap mm;
-	mm.setListOfMaps(inits);
+	gam::mapper::createMaps(ini, "map", mm);
 	const auto ga = mm.mapByClass<CGroundAwareOccupancyGrid>();
 	if (!ga) throw Failure(path + " defines no groundAwareGrid (its plane detection settings are needed)");
 	return *ga;

@@ -221,11 +221,8 @@ ConfiguredMaps loadConfig(const std::string& path)
 	if (!f) throw Failure("cannot read " + path);
 	const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
 	mrpt::config::CConfigFileMemory ini(text);
-	mrpt::maps::TSetOfMetricMapInitializers inits;
-	std::vector<gam::mapper::MapSpec> specs;
-	gam::mapper::loadMapDefinitions(ini, "map", inits, specs);
 	mrpt::maps::CMultiMetricMap mm;
-	mm.setListOfMaps(inits);
+	gam::mapper::createMaps(ini, "map", mm);
 	const auto ga = mm.mapByClass<CGroundAwareOccupancyGrid>();
 	const auto hb = mm.mapByClass<CHeightBandOccupancyGrid>();
 	if (!ga || !hb) throw Failure(path + " must define a groundAwareGrid and a heightBandGrid");

@@ -74,6 +74,14 @@ std::string RunSummary::text() const
 	return s.str();
 }
 
+void createMaps(const mrpt::config::CConfigFileBase& ini, const std::string& section, mrpt::maps::CMultiMetricMap& out)
+{
+	TSetOfMetricMapInitializers inits;
+	std::vector<MapSpec> specs;
+	loadMapDefinitions(ini, section, inits, specs);
+	out.setListOfMaps(inits);
+}
+
 std::map<std::string, mrpt::poses::CPose3D> readSensorPoses(
 	const mrpt::config::CConfigFileBase& ini, const std::string& configName)
 {

@@ -64,6 +64,11 @@ void loadMapDefinitions(
 	mrpt::maps::TSetOfMetricMapInitializers& inits, std::vector<MapSpec>& specs,
 	std::vector<std::string>* warnings = nullptr);
 
+/** Creates the maps of `section` in `out`, checked as the mapper checks them
+ * (loadMapDefinitions). For tools that need the maps of the mapper's .ini.
+ * Throws ConfigError. */
+void createMaps(const mrpt::config::CConfigFileBase& ini, const std::string& section, mrpt::maps::CMultiMetricMap& out);
+
 /** The [sensor_poses] section: `LABEL = x y z yaw pitch roll` (metres,
  * degrees) per sensor label; the mapper gives those observations this
  * sensorPose instead of the rawlog's. Throws ConfigError for a malformed entry. */
