@@ -25,8 +25,6 @@
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
-#include <mrpt/obs/CObservationOdometry.h>
-#include <mrpt/obs/CRawlog.h>
 #include <mrpt/obs/T3DPointsProjectionParams.h>
 #include <mrpt/system/filesystem.h>
 
@@ -42,6 +40,7 @@
 
 #include "gam/eval/Evaluation.h"
 #include "gam/mapper/Mapper.h"
+#include "gam/mapper/RawlogFrames.h"
 
 using mrpt::img::CImage;
 using mrpt::img::TColor;
@@ -64,33 +63,27 @@ struct Frame
 	CPose3D pose;
 };
 
+/** Every depth frame and 2D scan of a rawlog at its odometry pose, read as
+ * ground-aware-mapper reads it (gam::mapper::RawlogFrameReader). */
 std::vector<Frame> loadFrames(const std::string& file)
 {
 	if (!mrpt::system::fileExists(file)) throw Failure("cannot read rawlog " + file + ": no such file");
-	mrpt::obs::CRawlog rl;
-	bool ok = false;
+	std::vector<Frame> out;
 	try
 	{
-		ok = rl.loadFromRawLogFile(file);
-	}
-	catch (const std::exception&)
-	{
-	}
-	if (!ok) throw Failure("cannot read rawlog " + file + ": not an MRPT rawlog");
-	std::vector<Frame> out;
-	CPose3D pose;
-	for (size_t i = 0; i < rl.size(); i++)
-	{
-		if (rl.getType(i) != mrpt::obs::CRawlog::etObservation) continue;
-		const auto o = rl.getAsObservation(i);
-		if (auto od = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(o)) pose = CPose3D(od->odometry);
-		if (auto d = std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(o))
+		gam::mapper::RawlogFrameReader reader(file);
+		gam::mapper::Frame fr;
+		while (reader.next(fr))
 		{
-			d->load();
-			out.push_back({d, nullptr, pose});
+			if (auto d = std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(fr.obs))
+				out.push_back({d, nullptr, fr.robotPose});
+			else if (auto s = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(fr.obs))
+				out.push_back({nullptr, s, fr.robotPose});
 		}
-		if (auto s = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(o))
-			out.push_back({nullptr, s, pose});
+	}
+	catch (const std::exception& e)
+	{
+		throw Failure("cannot read rawlog " + file + ": " + e.what());
 	}
 	if (std::none_of(out.begin(), out.end(), [](const Frame& f) { return bool(f.depth); }))
 		throw Failure(file + " has no CObservation3DRangeScan");

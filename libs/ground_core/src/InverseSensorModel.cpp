@@ -395,7 +395,6 @@ void InverseSensorModel::computePaper(
 	// (delta = |c_v| - r_k), strongest for the farthest one; each obstacle voxel
 	// beyond it gives max(P_rho, 0.5) exp(-delta^2 / 2 sigma^2), which falls to
 	// the floor within a few decimetres and stays there.
-	const double twoSigma2 = 2.0 * m_params.sigma2;
 	for (size_t i = 0; i < n;)
 	{
 		const int bin = m_paperVoxels[i].bin;
@@ -419,12 +418,11 @@ void InverseSensorModel::computePaper(
 			}
 			const double r = fan.radius(k);
 			float occ = 0.5f, fr = saturated ? floorP : 0.5f;
-			if (farGround >= r)
-				fr = std::min(fr, float(m_params.K_g + (0.5 - m_params.K_g) / (1.0 + std::exp(farGround - r))));
+			if (farGround >= r) fr = std::min(fr, float(paper::groundRay(r, farGround, m_params)));
 			for (size_t j = 0; j < m_paperActive.size();)
 			{
-				const double d = double(m_paperActive[j].dist) - r;
-				const float p = float(m_paperActive[j].peak * std::exp(-d * d / twoSigma2));
+				const float p =
+					float(paper::obstacleRay(r, double(m_paperActive[j].dist), m_paperActive[j].peak, m_params));
 				if (p > 0.5f)
 				{
 					occ = std::max(occ, p);
