@@ -13,6 +13,7 @@ void PipelineParams::validate() const
 	checkParamRanges(*this, "");
 	projection.validate();
 	rrt.validate();
+	missing.validate();
 	{
 		// The per-frame 2.5D map: refuse what would not fit in memory before allocating it.
 		GridGeometry g;
@@ -49,6 +50,7 @@ void GroundAwarePipeline::setParams(const PipelineParams& p)
 	p.validate();
 	m_rrt.setParams(p.rrt);
 	m_ism.setParams(p.ism);
+	m_missing.setParams(p.missing);
 	m_params = p;
 }
 
@@ -62,6 +64,8 @@ void GroundAwarePipeline::resetResult()
 	m_result.sensor.setZero();
 	m_result.detection.clear();
 	m_result.ism = IsmStats{};
+	m_result.missing = MissingFloorStats{};
+	m_missing.clear();
 	m_result.ms = StageTimes{};
 }
 
@@ -119,11 +123,24 @@ const FrameResult& GroundAwarePipeline::process(
 	m_ism.compute(m_grid, m_result.detection, m_result.sensor, m_params.projection.max_range, m_result.ism);
 	const auto t4 = clk::now();
 
+	// 4. Missing floor: where the ground predicts a floor return and the
+	// camera returned nothing (an extension: not in the paper's model).
+	if (m_params.missing.enabled && m_params.ism.model != MethodVariant::Paper && frame.has_image &&
+		m_result.detection.ok() && m_result.ism.applied)
+	{
+		const double range = std::min<double>(frame.max_range, m_params.projection.max_range);
+		m_missing.compute(
+			frame, m_projector, m_params.projection.decimation, range, m_result.detection.plane(), m_grid,
+			m_ism.classes(), m_result.missing);
+	}
+	const auto t5 = clk::now();
+
 	m_result.valid = true;
 	m_result.ms.projection = ms(t0, t1);
 	m_result.ms.outliers = ms(t1, t2);
 	m_result.ms.ground = ms(t2, t3);
 	m_result.ms.ism = ms(t3, t4);
+	m_result.ms.missing = ms(t4, t5);
 	return m_result;
 }
 

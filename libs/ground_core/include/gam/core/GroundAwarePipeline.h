@@ -13,6 +13,7 @@
 #include "gam/core/DepthProjector.h"
 #include "gam/core/ElevationGrid.h"
 #include "gam/core/InverseSensorModel.h"
+#include "gam/core/MissingFloor.h"
 #include "gam/core/Parameters.h"
 #include "gam/core/RrtGroundDetector.h"
 #include "gam/core/SensorFrame.h"
@@ -38,6 +39,8 @@ struct PipelineParams
 	bool idw_in_ism = false;
 	RrtGpdParams rrt;
 	IsmParams ism;
+	/** Missing floor (depth images only; not in the paper's model). */
+	MissingFloorParams missing;
 
 	template <class Self, class Visit>
 	static void forEachParam(Self& p, Visit&& visit)
@@ -51,6 +54,7 @@ struct PipelineParams
 			ParamInfo{"idw_in_ism", 0, 1, "IDW cells enter the ISM as one-sample voxels (paper Fig. 4)"}, p.idw_in_ism);
 		RrtGpdParams::forEachParam(p.rrt, visit);
 		IsmParams::forEachParam(p.ism, visit);
+		MissingFloorParams::forEachParam(p.missing, visit);
 	}
 	/** Every range and every rule between parameters; throws
 	 * std::invalid_argument naming the key. */
@@ -75,6 +79,7 @@ struct StageTimes
 	double outliers = 0;    ///< 3-sigma filter + IDW
 	double ground = 0;      ///< RRT-GPD + RANSAC
 	double ism = 0;         ///< inverse sensor model
+	double missing = 0;     ///< missing floor
 };
 
 /** What the last frame gave. */
@@ -86,6 +91,7 @@ struct FrameResult
 	Eigen::Vector3d sensor{0, 0, 0};  ///< sensor position (map frame)
 	GroundDetection detection;
 	IsmStats ism;
+	MissingFloorStats missing;
 	StageTimes ms;
 };
 
@@ -113,6 +119,8 @@ class GroundAwarePipeline
 	const ElevationGrid& frameGrid() const { return m_grid; }
 	/** Its evidence (P(occupied) per frame cell) and voxel classes. */
 	const InverseSensorModel& ism() const { return m_ism; }
+	/** Missing floor of the last frame (frame-grid cells). */
+	const MissingFloorDetector& missingFloor() const { return m_missing; }
 	/** The projector, e.g. to force the baseline row loop in tests. */
 	DepthProjector& projector() { return m_projector; }
 
@@ -125,6 +133,7 @@ class GroundAwarePipeline
 	BinnedPoints m_bins;
 	RrtGroundDetector m_rrt;
 	InverseSensorModel m_ism;
+	MissingFloorDetector m_missing;
 	FrameResult m_result;
 };
 

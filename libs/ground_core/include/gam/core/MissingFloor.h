@@ -1,0 +1,143 @@
+// Ground-aware mapping for MRPT
+// Missing floor (issue #13): where the ground plane says a depth pixel should
+// have returned the floor within the sensor's range, and the camera returned
+// nothing (0) or something far below it, the floor is not there as seen --
+// a hole deeper than the range, a black or absorbing surface, a pit behind
+// glass. Such cells form a third state next to free and occupied.
+//
+// Floor that merely drops out (a ToF camera at grazing incidence, a shiny
+// patch) must not look like a hole, so a cell is judged against the dropout
+// rate of the floor measured in the same frame at the same range: with a
+// per-ray dropout rate q, floor leaves all n rays of a cell empty with
+// probability q^n; the cell is missing floor only when that chance is below
+// `alpha`. Missing cells are kept per connected region, and only regions that
+// border floor seen in the frame (an edge of valid floor around the gap).
+// Pure code: no MRPT, no I/O; no heap allocation per frame once sized.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "gam/core/DepthProjector.h"
+#include "gam/core/ElevationGrid.h"
+#include "gam/core/InverseSensorModel.h"
+#include "gam/core/Parameters.h"
+#include "gam/core/PlaneFit.h"
+#include "gam/core/SensorFrame.h"
+
+namespace gam
+{
+struct MissingFloorParams
+{
+	bool enabled = true;
+	/** Nearer than this the sensor returns nothing anyway (Kinect One:
+	 * 0.5 m): no floor is expected there. Depth along +X [m]. */
+	double min_range = 0.5;
+	/** A cell needs at least this many empty rays to be judged. */
+	int min_rays = 3;
+	/** Largest chance q^n that floor with the measured dropout rate q leaves a
+	 * cell's n rays all empty, for the cell to count as missing floor. */
+	double alpha = 1e-3;
+	/** Range bins of the measured dropout rate [m] (depth along +X). */
+	double range_bin = 0.5;
+	/** Missing floor within this 2D distance of the sensor is folded into the
+	 * occupancy grid as an obstacle (the robot must stop before it); beyond it
+	 * it is only in the missing-floor layer. Default: it always blocks. [m] */
+	double block_range = 1000.0;
+	/** A return at least this much deeper than the floor point its ray should
+	 * have met counts as "no floor" (a hole deeper than the range); nearer
+	 * returns beyond the range are floor noise at the range limit. [m] */
+	double beyond_margin = 0.10;
+
+	template <class Self, class Visit>
+	static void forEachParam(Self& p, Visit&& visit)
+	{
+		visit(ParamInfo{"missing_floor", 0, 1, "mark floor that returned no depth where the ground predicts it"}, p.enabled);
+		visit(
+			ParamInfo{"missing_floor_min_range", 0, 100, "no floor return is expected nearer than this depth [m]"},
+			p.min_range);
+		visit(ParamInfo{"missing_floor_min_rays", 1, 65535, "empty rays a cell needs to be judged"}, p.min_rays);
+		visit(
+			ParamInfo{"missing_floor_alpha", 1e-300, 1, "max chance that dropping-out floor leaves a cell this empty"},
+			p.alpha);
+		visit(ParamInfo{"missing_floor_bin", 0.05, 10, "range bin of the measured dropout rate [m]"}, p.range_bin);
+		visit(
+			ParamInfo{
+				"missing_floor_block_range", 0, 1e6,
+				"missing floor within this distance of the sensor is an obstacle in the grid [m]"},
+			p.block_range);
+		visit(
+			ParamInfo{"missing_floor_beyond_margin", 0, 100, "a return this far below the floor is no floor [m]"},
+			p.beyond_margin);
+	}
+	/** Throws std::invalid_argument naming the parameter out of range. */
+	void validate() const;
+};
+
+struct MissingFloorStats
+{
+	size_t rays = 0;          ///< pixels whose ray meets the ground within range
+	size_t empty_rays = 0;    ///< of those, no return (or one far below the floor)
+	size_t candidates = 0;    ///< cells with no sample, enough empty rays, unlikely as dropout
+	size_t cells = 0;         ///< missing-floor cells (in regions bordering floor)
+	size_t regions = 0;       ///< their connected regions
+	size_t unbordered = 0;    ///< candidate regions dropped: no seen floor next to them
+	size_t blocking = 0;      ///< missing cells within block_range
+	bool applied = false;     ///< the stage ran on this frame
+};
+
+namespace missing
+{
+/** The chance that floor with per-ray dropout rate q leaves all n rays of a
+ * cell empty (independent dropouts): q^n. */
+double emptyCellChance(double q, int n);
+}  // namespace missing
+
+class MissingFloorDetector
+{
+   public:
+	explicit MissingFloorDetector(const MissingFloorParams& p = {}) { setParams(p); }
+	/** Validates (throws std::invalid_argument), then keeps `p`. */
+	void setParams(const MissingFloorParams& p)
+	{
+		p.validate();
+		m_params = p;
+	}
+	const MissingFloorParams& params() const { return m_params; }
+
+	/** One depth frame (frame.has_image) after the 2.5D map, the ground and
+	 * the ISM classes of that frame are known. `projector` holds the ray
+	 * table of frame.intrinsics (its project() ran on this frame);
+	 * `decimation` is the projection's; `maxRange` the range within which the
+	 * sensor returns floor (depth for depth images, range along the ray for
+	 * range images) [m]. */
+	void compute(
+		const SensorFrame& frame, const DepthProjector& projector, int decimation, double maxRange,
+		const Plane& ground, const ElevationGrid& grid, const std::vector<VoxelClass>& classes,
+		MissingFloorStats& stats);
+	/** Forgets the last frame's cells. */
+	void clear();
+
+	/** Missing-floor cells of the last frame (frame-grid indices). */
+	const std::vector<uint32_t>& cells() const { return m_cells; }
+	/** Those within block_range of the sensor. */
+	const std::vector<uint32_t>& blockingCells() const { return m_blocking; }
+	bool isMissing(uint32_t cell) const { return cell < m_mark.size() && m_mark[cell] == kMissing; }
+	/** Empty rays per frame cell in the last frame (0 where none). */
+	uint16_t emptyRays(uint32_t cell) const { return cell < m_empty.size() ? m_empty[cell] : 0; }
+	/** The dropout rate measured in the last frame at depth `depth` (rays that
+	 * met the ground in that range bin and returned nothing); 1 where no ray
+	 * met the ground there (no evidence). */
+	double dropoutRate(double depth) const;
+
+   private:
+	static constexpr uint8_t kCandidate = 1, kMissing = 2, kVisited = 4;
+	MissingFloorParams m_params;
+	std::vector<uint16_t> m_empty;  ///< per frame cell
+	std::vector<uint8_t> m_mark;    ///< per frame cell
+	std::vector<uint32_t> m_touched, m_cells, m_blocking, m_queue, m_region;
+	std::vector<uint32_t> m_binRays, m_binEmpty;
+};
+
+}  // namespace gam

@@ -1,0 +1,187 @@
+#include "gam/core/MissingFloor.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace gam
+{
+void MissingFloorParams::validate() const
+{
+	checkParamRanges(*this, "");
+}
+
+namespace missing
+{
+double emptyCellChance(double q, int n)
+{
+	if (n <= 0) return 1.0;
+	return std::pow(std::clamp(q, 0.0, 1.0), n);
+}
+}  // namespace missing
+
+void MissingFloorDetector::clear()
+{
+	for (uint32_t c : m_touched)
+	{
+		m_empty[c] = 0;
+		m_mark[c] = 0;
+	}
+	m_touched.clear();
+	m_cells.clear();
+	m_blocking.clear();
+	std::fill(m_binRays.begin(), m_binRays.end(), 0u);
+	std::fill(m_binEmpty.begin(), m_binEmpty.end(), 0u);
+}
+
+double MissingFloorDetector::dropoutRate(double depth) const
+{
+	if (!(depth >= 0)) return 1.0;
+	const size_t b = size_t(depth / m_params.range_bin);
+	if (b >= m_binRays.size() || m_binRays[b] == 0) return 1.0;
+	return double(m_binEmpty[b]) / double(m_binRays[b]);
+}
+
+void MissingFloorDetector::compute(
+	const SensorFrame& frame, const DepthProjector& projector, int decimation, double maxRange, const Plane& ground,
+	const ElevationGrid& grid, const std::vector<VoxelClass>& classes, MissingFloorStats& stats)
+{
+	clear();
+	stats = MissingFloorStats{};
+	const GridGeometry& g = grid.geometry();
+	const size_t N = g.cellCount();
+	if (m_empty.size() != N)
+	{
+		m_empty.assign(N, 0);
+		m_mark.assign(N, 0);
+	}
+	if (!frame.has_image || classes.size() != N || !(maxRange > m_params.min_range)) return;
+	const RangeImageView& img = frame.image;
+	const PinholeIntrinsics& K = frame.intrinsics;
+	if (projector.rayTableSize() != size_t(K.width) * size_t(K.height) || img.rows != K.height || img.cols != K.width)
+		return;
+	const size_t bins = size_t(std::ceil(maxRange / m_params.range_bin)) + 1;
+	if (m_binRays.size() < bins)
+	{
+		m_binRays.resize(bins, 0u);
+		m_binEmpty.resize(bins, 0u);
+	}
+
+	// The plane in the map frame, normalized: n.p + d = 0, n pointing up.
+	Eigen::Vector3d n(ground.a, ground.b, ground.c);
+	double d = ground.d;
+	const double nn = n.norm();
+	if (!(nn > 0)) return;
+	n /= nn;
+	d /= nn;
+	if (n.z() < 0)
+	{
+		n = -n;
+		d = -d;
+	}
+	const Eigen::Vector3d s = frame.sensor_position;
+	const double h = n.dot(s) + d;  // sensor height over the plane
+	if (!(h > 0)) return;
+	const Eigen::Matrix3d R = frame.sensor_to_map.R.cast<double>();
+	// The ray of pixel (r, c) is R (1, fy, fz): its component along n, per
+	// unit of depth, is n.R (1, fy, fz) = nr.(1, fy, fz).
+	const Eigen::Vector3d nr = R.transpose() * n;
+	const float units = img.units;
+	const int step = std::max(1, decimation);
+
+	// 1. Every pixel whose ray meets the ground inside the range: one ray of
+	// the cell it meets; empty if the camera returned nothing there.
+	for (int r = 0; r < img.rows; r += step)
+		for (int c = 0; c < img.cols; c += step)
+		{
+			const Eigen::Vector2f f = projector.rayFactor(r, c);
+			const double down = nr.x() + nr.y() * f.x() + nr.z() * f.y();
+			if (!(down < 0)) continue;  // parallel to the ground or rising
+			const double t = -h / down;  // depth at which the ray meets the ground
+			const double norm = img.is_depth ? 1.0 : std::sqrt(1.0 + double(f.x()) * f.x() + double(f.y()) * f.y());
+			const double expected = t * norm;  // in the image's own measure
+			if (expected < m_params.min_range || expected > maxRange) continue;
+			const Eigen::Vector3d p = s + t * (R * Eigen::Vector3d(1.0, f.x(), f.y()));
+			const int cx = g.ix(p.x()), cy = g.iy(p.y());
+			if (!g.inside(cx, cy)) continue;
+			const uint16_t v = img.at(r, c);
+			const double got = double(v) * units;
+			const bool empty = v == 0 || (got > maxRange && got > expected + m_params.beyond_margin);
+			const size_t bin = size_t(expected / m_params.range_bin);
+			m_binRays[bin]++;
+			stats.rays++;
+			if (!empty) continue;
+			m_binEmpty[bin]++;
+			stats.empty_rays++;
+			const uint32_t cell = uint32_t(g.index(cx, cy));
+			if (m_empty[cell] == 0) m_touched.push_back(cell);
+			if (m_empty[cell] < 65535) m_empty[cell]++;
+		}
+
+	// 2. Candidate cells: nothing was seen there, and floor with the dropout
+	// rate measured at that range would rarely leave so many rays empty.
+	const Eigen::Vector3d xAxis = R.col(0);
+	for (uint32_t cell : m_touched)
+	{
+		const int n_ = m_empty[cell];
+		if (n_ < m_params.min_rays || grid.cell(cell).count > 0 || classes[cell] != VoxelClass::None) continue;
+		const int cx = int(cell % uint32_t(g.nx)), cy = int(cell / uint32_t(g.nx));
+		const double x = g.cx(cx), y = g.cy(cy);
+		if (std::abs(n.z()) < 1e-9) continue;
+		const Eigen::Vector3d pc(x, y, -(n.x() * x + n.y() * y + d) / n.z());
+		const double depth = img.is_depth ? (pc - s).dot(xAxis) : (pc - s).norm();
+		if (missing::emptyCellChance(dropoutRate(depth), n_) > m_params.alpha) continue;
+		m_mark[cell] = kCandidate;
+		stats.candidates++;
+	}
+
+	// 3. Connected regions of candidates (8-neighbours) that border seen floor.
+	const double block2 = m_params.block_range * m_params.block_range;
+	for (uint32_t seed : m_touched)
+	{
+		if (m_mark[seed] != kCandidate) continue;
+		m_region.clear();
+		m_queue.clear();
+		m_queue.push_back(seed);
+		m_mark[seed] |= kVisited;
+		bool bordered = false;
+		for (size_t qi = 0; qi < m_queue.size(); qi++)
+		{
+			const uint32_t c = m_queue[qi];
+			m_region.push_back(c);
+			const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
+			for (int dy = -1; dy <= 1; dy++)
+				for (int dx = -1; dx <= 1; dx++)
+				{
+					if (!dx && !dy) continue;
+					const int ax = cx + dx, ay = cy + dy;
+					if (!g.inside(ax, ay)) continue;
+					const uint32_t a = uint32_t(g.index(ax, ay));
+					if (classes[a] == VoxelClass::Ground) bordered = true;
+					if (m_mark[a] == kCandidate)
+					{
+						m_mark[a] |= kVisited;
+						m_queue.push_back(a);
+					}
+				}
+		}
+		if (!bordered)
+		{
+			stats.unbordered++;
+			continue;
+		}
+		stats.regions++;
+		for (uint32_t c : m_region)
+		{
+			m_mark[c] = kMissing;
+			m_cells.push_back(c);
+			const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
+			const double dx = g.cx(cx) - s.x(), dy = g.cy(cy) - s.y();
+			if (dx * dx + dy * dy <= block2) m_blocking.push_back(c);
+		}
+	}
+	stats.cells = m_cells.size();
+	stats.blocking = m_blocking.size();
+	stats.applied = true;
+}
+
+}  // namespace gam

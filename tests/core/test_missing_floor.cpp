@@ -1,0 +1,223 @@
+// Missing floor (issue #13): a camera 1 m above the floor looking straight
+// down, so every pixel's floor point and the expected depth (1 m) are known by
+// hand, and each 5 cm cell of the grid receives exactly 4 x 4 pixels.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <vector>
+
+#include "gam/core/MissingFloor.h"
+#include "test_helpers.h"
+
+using namespace gam;
+
+namespace
+{
+// 40 x 40 pixels, fx = fy = 80, principal point at the image centre. Looking
+// down from h = 1 m, pixel (r, c) meets the floor at
+//   x = h (cy - r) / fy = (19.5 - r) / 80,  y = (19.5 - c) / 80,
+// so a pixel covers 12.5 mm and 4 x 4 pixels fill one 5 cm cell. The grid
+// starts at -0.5, so cell index = floor((x + 0.5) / 0.05): rows 0-3 give x in
+// [0.20625, 0.24375] (cell 14), rows 4-7 cell 13, ..., rows 16-19 (x 0.04375
+// .. 0.00625) cell 10, rows 20-23 (x -0.00625 .. -0.04375) cell 9; the same
+// for columns and y.
+constexpr int kSize = 40;
+constexpr double kH = 1.0;
+
+struct Scene
+{
+	std::vector<uint16_t> depth = std::vector<uint16_t>(kSize * kSize, 1000);  // 1 m in mm: floor
+	uint16_t& at(int r, int c) { return depth[size_t(r) * kSize + size_t(c)]; }
+};
+
+struct Result
+{
+	MissingFloorDetector det;
+	MissingFloorStats stats;
+	ElevationGrid grid;
+};
+
+/** Runs the projector, the 2.5D map, hand-made classes (every cell with
+ * samples is Ground) and the detector on `scene`. The grid is 20 x 20 cells
+ * from (-0.5, -0.5): the image sees only its middle 10 x 10 cells. */
+void run(const Scene& scene, Result& out, MissingFloorParams p = {})
+{
+	PinholeIntrinsics K;
+	K.width = K.height = kSize;
+	K.fx = K.fy = 80;
+	K.cx = K.cy = 19.5;
+	RangeImageView img;
+	img.data = scene.depth.data();
+	img.rows = img.cols = kSize;
+	img.stride = kSize;
+	img.units = 0.001f;
+	img.is_depth = true;
+
+	SensorFrame frame;
+	frame.has_image = true;
+	frame.image = img;
+	frame.intrinsics = K;
+	// Pitch 90 deg (nose down): sensor +X -> world -Z, +Y -> +Y, +Z -> +X.
+	const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+	frame.sensor_to_map.R = R.cast<float>();
+	frame.sensor_to_map.t = Eigen::Vector3f(0, 0, float(kH));
+	frame.sensor_position = Eigen::Vector3d(0, 0, kH);
+	frame.max_range = 4.5f;
+
+	GridGeometry g;
+	g.x_min = g.y_min = -0.5;
+	g.resolution = 0.05;
+	g.nx = g.ny = 20;
+	out.grid.resize(g);
+	BinnedPoints bins;
+	DepthProjector proj;
+	ProjectionFilter f;
+	f.max_range = 4.5f;
+	proj.project(img, K, frame.sensor_to_map, f, out.grid, bins);
+	out.grid.insert(bins, OutlierFilterParams{});
+	std::vector<VoxelClass> classes(g.cellCount(), VoxelClass::None);
+	for (size_t i = 0; i < g.cellCount(); i++)
+		if (out.grid.cell(i).count) classes[i] = VoxelClass::Ground;
+
+	Plane floor;  // z = 0
+	out.det.setParams(p);
+	out.det.compute(frame, proj, 1, 4.5, floor, out.grid, classes, out.stats);
+}
+
+uint32_t cellOf(int ix, int iy) { return uint32_t(iy * 20 + ix); }
+}  // namespace
+
+TEST(MissingFloor, EmptyCellChanceIsQToTheN)
+{
+	// Floor that drops 4 % of its rays leaves 16 rays all empty with 0.04^16.
+	EXPECT_NEAR(missing::emptyCellChance(0.04, 16), std::pow(0.04, 16), 1e-30);
+	EXPECT_DOUBLE_EQ(missing::emptyCellChance(0.5, 3), 0.125);
+	EXPECT_DOUBLE_EQ(missing::emptyCellChance(1.0, 50), 1.0);  // all floor drops: no evidence
+	EXPECT_DOUBLE_EQ(missing::emptyCellChance(0.3, 0), 1.0);
+}
+
+TEST(MissingFloor, DarkHoleInSeenFloorIsMarked)
+{
+	// An 8 x 8 pixel hole returning nothing: rows 16-23, cols 24-31, i.e.
+	// x cells 10 (rows 16-19) and 9 (rows 20-23); y = (19.5 - c) / 80 is
+	// -0.05625 .. -0.09375 for cols 24-27 (floor(8.875) .. floor(8.125) = 8)
+	// and -0.10625 .. -0.14375 for cols 28-31 (7).
+	Scene s;
+	for (int r = 16; r < 24; r++)
+		for (int c = 24; c < 32; c++) s.at(r, c) = 0;
+	Result res;
+	MissingFloorParams p;
+	// The hole's cells are at 2D distances sqrt(0.025^2 + 0.075^2) = 0.079 m
+	// (y cell 8, centre -0.075) and sqrt(0.025^2 + 0.125^2) = 0.127 m (y cell
+	// 7, centre -0.125) from the sensor: a 0.1 m block range keeps the first two.
+	p.block_range = 0.1;
+	run(s, res, p);
+	// Every one of the 1600 rays meets the floor at depth 1 m; 64 are empty.
+	EXPECT_EQ(res.stats.rays, 1600u);
+	EXPECT_EQ(res.stats.empty_rays, 64u);
+	EXPECT_NEAR(res.det.dropoutRate(1.0), 64.0 / 1600.0, 1e-12);  // q = 0.04
+	// Each hole cell: 16 empty rays, 0.04^16 = 4e-23 << alpha = 1e-3.
+	for (int ix : {9, 10})
+		for (int iy : {7, 8})
+		{
+			EXPECT_EQ(res.det.emptyRays(cellOf(ix, iy)), 16) << ix << "," << iy;
+			EXPECT_TRUE(res.det.isMissing(cellOf(ix, iy))) << ix << "," << iy;
+		}
+	EXPECT_EQ(res.stats.cells, 4u);
+	EXPECT_EQ(res.stats.regions, 1u);
+	EXPECT_EQ(res.stats.blocking, 2u);
+	for (uint32_t c : res.det.blockingCells()) EXPECT_EQ(int(c / 20), 8);
+	// The floor around it is not missing.
+	EXPECT_FALSE(res.det.isMissing(cellOf(11, 8)));
+	EXPECT_FALSE(res.det.isMissing(cellOf(9, 9)));
+}
+
+TEST(MissingFloor, OutsideTheFieldOfViewIsNotMarked)
+{
+	// The image covers x, y in [-0.25, 0.25]: grid cells 5-14. The 20 x 20
+	// grid's outer ring (e.g. cell (0, 0) at -0.475, -0.475) gets no ray at all,
+	// so nothing can be said there, even with a dark hole inside the view.
+	Scene s;
+	for (int r = 16; r < 24; r++)
+		for (int c = 24; c < 32; c++) s.at(r, c) = 0;
+	Result res;
+	run(s, res);
+	for (int ix = 0; ix < 20; ix++)
+		for (int iy = 0; iy < 20; iy++)
+		{
+			const bool inView = ix >= 5 && ix <= 14 && iy >= 5 && iy <= 14;
+			if (inView) continue;
+			EXPECT_EQ(res.det.emptyRays(cellOf(ix, iy)), 0) << ix << "," << iy;
+			EXPECT_FALSE(res.det.isMissing(cellOf(ix, iy))) << ix << "," << iy;
+		}
+}
+
+TEST(MissingFloor, FloorThatDropsOutOftenIsNotAHole)
+{
+	// A shiny floor: 9 of every 10 pixels return nothing (index % 10 != 0:
+	// with 40 columns only columns 0, 10, 20 and 30 return), and the cell of
+	// rows 0-3, cols 0-3 (x and y cell 14) returns nothing at all. Many cells
+	// (e.g. cols 4-7) get no return either: dropouts, not holes.
+	Scene s;
+	for (int i = 0; i < kSize * kSize; i++)
+		if (i % 10 != 0) s.depth[size_t(i)] = 0;
+	for (int r = 0; r < 4; r++)
+		for (int c = 0; c < 4; c++) s.at(r, c) = 0;
+	Result res;
+	run(s, res);
+	// Valid pixels: i % 10 == 0 gives 160, minus those in rows 0-3, cols 0-3
+	// (i = 0, 40, 80, 120: 4 of them) = 156; empty = 1600 - 156 = 1444.
+	EXPECT_EQ(res.stats.empty_rays, 1444u);
+	const double q = 1444.0 / 1600.0;  // 0.9025
+	EXPECT_NEAR(res.det.dropoutRate(1.0), q, 1e-12);
+	// 0.9025^16 = 0.194: such floor often leaves a cell empty -> not missing.
+	EXPECT_GT(missing::emptyCellChance(q, 16), 1e-3);
+	EXPECT_EQ(res.det.emptyRays(cellOf(14, 14)), 16);
+	EXPECT_FALSE(res.det.isMissing(cellOf(14, 14)));
+	EXPECT_EQ(res.det.emptyRays(cellOf(12, 13)), 16);  // cols 4-7 (y cell 13): all empty
+	EXPECT_FALSE(res.det.isMissing(cellOf(12, 13)));
+	EXPECT_EQ(res.stats.cells, 0u);
+}
+
+TEST(MissingFloor, ReturnsFarBelowTheFloorCountAsNoFloor)
+{
+	// A hole deeper than the range: the camera returns 6 m where the floor is
+	// at 1 m (beyond the 4.5 m range and more than the 0.10 m margin below the
+	// floor) -> empty rays: rows and cols 16-23 are x and y cells 9 and 10.
+	Scene s;
+	for (int r = 16; r < 24; r++)
+		for (int c = 16; c < 24; c++) s.at(r, c) = 6000;
+	Result res;
+	run(s, res);
+	EXPECT_EQ(res.stats.empty_rays, 64u);
+	EXPECT_EQ(res.stats.cells, 4u);
+	EXPECT_TRUE(res.det.isMissing(cellOf(9, 9)));
+	EXPECT_TRUE(res.det.isMissing(cellOf(10, 10)));
+}
+
+TEST(MissingFloor, NoSeenFloorAroundMeansNoRegion)
+{
+	// Everything returns nothing: no cell has samples, no cell is Ground, and
+	// the measured dropout rate is 1 (1600 of 1600): nothing is marked.
+	Scene s;
+	std::fill(s.depth.begin(), s.depth.end(), 0);
+	Result res;
+	run(s, res);
+	EXPECT_EQ(res.stats.empty_rays, 1600u);
+	EXPECT_DOUBLE_EQ(res.det.dropoutRate(1.0), 1.0);
+	EXPECT_EQ(res.stats.cells, 0u);
+}
+
+TEST(MissingFloor, ParametersAreValidated)
+{
+	MissingFloorParams p;
+	p.min_rays = 0;
+	EXPECT_THROW(MissingFloorDetector{p}, std::invalid_argument);
+	p = {};
+	p.alpha = 2;
+	EXPECT_THROW(MissingFloorDetector{p}, std::invalid_argument);
+	p = {};
+	p.range_bin = 0;
+	EXPECT_THROW(MissingFloorDetector{p}, std::invalid_argument);
+}
