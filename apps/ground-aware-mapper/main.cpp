@@ -57,6 +57,11 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<int> aLocalCells(
 			"", "local-size-cells", "side of the local window in cells (with --local-map)", false, 600, "N", cmd);
 		TCLAP::ValueArg<long> aMaxFrames("n", "max-frames", "stop after N frames (0 = all)", false, 0, "N", cmd);
+		TCLAP::ValueArg<long> aSnapshotEvery(
+			"", "snapshot-every",
+			"after every N-th frame, write the map_server maps (<label>.yaml/.pgm) of every 2D grid into "
+			"DIR/snapshots/NNNNNN/ (NNNNNN = frames so far; index in DIR/snapshots/index.csv); 0 = none",
+			false, 0, "N", cmd);
 		TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line on stderr", cmd);
 		if (const int rc = gam::parseCommandLine(cmd, argc, argv, "ground-aware-mapper"); rc >= 0) return rc;
 
@@ -68,12 +73,15 @@ int main(int argc, char** argv)
 		if (aRawlog.getValue().empty()) return fail(2, "missing --rawlog FILE.rawlog (see --help)");
 		if (aOut.getValue().empty()) return fail(2, "missing --out DIR (see --help)");
 		if (aMaxFrames.getValue() < 0) return fail(2, "--max-frames must be >= 0");
+		if (aSnapshotEvery.getValue() < 0 || aSnapshotEvery.getValue() > 1000000)
+			return fail(2, "--snapshot-every must be in [0, 1000000]");
 		o.rawlogPath = aRawlog.getValue();
 		o.outDir = aOut.getValue();
 		o.section = aSection.getValue();
 		o.localMap = aLocal.getValue();
 		o.localCells = aLocalCells.getValue();
 		o.maxFrames = size_t(aMaxFrames.getValue());
+		o.snapshotEvery = size_t(aSnapshotEvery.getValue());
 		o.progress = !aQuiet.getValue();
 		if (aConfig.getValue().empty())
 		{

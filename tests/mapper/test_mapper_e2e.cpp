@@ -494,6 +494,60 @@ TEST_F(MapperE2E, LocalMapModeKeepsARobotCentredWindow)
 	EXPECT_FLOAT_EQ(pFree(ga, 1.42, 0.52), pFree(full, 1.42, 0.52));
 }
 
+// --snapshot-every N: the map_server maps after every N-th frame, each equal to
+// the final maps of a run stopped there (--max-frames), plus an index.
+TEST_F(MapperE2E, SnapshotEveryWritesTheMapsAfterEveryNthFrame)
+{
+	const std::string out = freshDir("out_snap");
+	const auto r = runMapper("--rawlog '" + obsRawlog + "' --out '" + out + "' --snapshot-every 2 -q");
+	ASSERT_EQ(r.rc, 0) << r.err;
+	EXPECT_NE(r.out.find("; 2 snapshots"), std::string::npos) << r.out;
+	const std::string snaps = out + "/snapshots";
+	std::set<std::string> entries;
+	for (const auto& de : fs::directory_iterator(snaps)) entries.insert(de.path().filename().string());
+	EXPECT_EQ(entries, (std::set<std::string>{"000002", "000004", "index.csv"}));
+	for (const char* n : {"000002", "000004"})
+	{
+		std::set<std::string> files;
+		for (const auto& de : fs::directory_iterator(snaps + "/" + n)) files.insert(de.path().filename().string());
+		std::set<std::string> expect;
+		for (const auto& g : kGrids) expect.insert({g + ".yaml", g + ".pgm"});
+		EXPECT_EQ(files, expect) << n;
+	}
+	// After the last frame = the final maps; after frame 2 = the final maps of --max-frames 2.
+	const std::string two = freshDir("out_max2");
+	ASSERT_EQ(runMapper("--rawlog '" + obsRawlog + "' --out '" + two + "' --max-frames 2 -q").rc, 0);
+	for (const auto& g : kGrids)
+	{
+		SCOPED_TRACE(g);
+		EXPECT_EQ(slurp(snaps + "/000004/" + g + ".pgm"), slurp(out + "/" + g + ".pgm"));
+		EXPECT_EQ(slurp(snaps + "/000004/" + g + ".yaml"), slurp(out + "/" + g + ".yaml"));
+		EXPECT_EQ(slurp(snaps + "/000002/" + g + ".pgm"), slurp(two + "/" + g + ".pgm"));
+		// The evaluator reads a snapshot like any map.
+		const gam::eval::RosMap y = gam::eval::loadRosMap(snaps + "/000002/" + g + ".yaml");
+		EXPECT_EQ(fs::path(y.imagePath).filename().string(), g + ".pgm");
+	}
+	// The robot moved between frames 2 and 4: the ground-aware grid changed.
+	EXPECT_NE(slurp(snaps + "/000002/ground_aware.pgm"), slurp(snaps + "/000004/ground_aware.pgm"));
+	EXPECT_EQ(
+		slurp(snaps + "/index.csv"),
+		"snapshot,frames,frame_index,rawlog_entry,robot_x,robot_y,robot_yaw_deg\n"
+		"000002,2,1,4,0.250000,0.000000,0.000000\n"
+		"000004,4,3,8,0.750000,0.000000,0.000000\n");
+	// A second run replaces the snapshots as a whole.
+	ASSERT_EQ(runMapper("--rawlog '" + obsRawlog + "' --out '" + out + "' --snapshot-every 3 -q").rc, 0);
+	entries.clear();
+	for (const auto& de : fs::directory_iterator(snaps)) entries.insert(de.path().filename().string());
+	EXPECT_EQ(entries, (std::set<std::string>{"000003", "index.csv"}));
+	// Without the option: no snapshots folder.
+	EXPECT_FALSE(fs::exists(obsOut + "/snapshots"));
+	// A negative value is a command-line error.
+	const auto bad = runMapper("--rawlog '" + obsRawlog + "' --out '" + out + "_bad' --snapshot-every -1");
+	EXPECT_EQ(bad.rc, 2);
+	EXPECT_EQ(bad.err, "ground-aware-mapper: error: --snapshot-every must be in [0, 1000000]\n");
+	EXPECT_FALSE(fs::exists(out + "_bad"));
+}
+
 TEST(MapperCli, PrintDefaultConfigIsTheConfigFile)
 {
 	const auto r = runMapper("--print-default-config");

@@ -4,6 +4,7 @@
 #include <gam/mapper/RawlogFrames.h>
 #include <gam/maps/MapRegistry.h>
 #include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/core/bits_math.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
@@ -53,7 +54,9 @@ std::string RunSummary::text() const
 	std::ostringstream s;
 	s << "frames: " << frames << " (" << frames3D << " 3D scans, " << frames2D << " 2D scans";
 	if (framesWithoutOdometry) s << ", " << framesWithoutOdometry << " without odometry: robot at the origin";
-	s << ") in " << std::fixed << std::setprecision(2) << seconds << " s\n";
+	s << ") in " << std::fixed << std::setprecision(2) << seconds << " s";
+	if (snapshots) s << "; " << snapshots << " snapshots";
+	s << "\n";
 	size_t wl = 5, wc = 5;
 	for (const auto& m : maps) wl = std::max(wl, m.label.size()), wc = std::max(wc, m.className.size());
 	const bool both = frames3D > 0 && frames2D > 0;
@@ -106,6 +109,8 @@ std::map<std::string, mrpt::poses::CPose3D> readSensorPoses(
 // ---------------------------------------------------------------------------
 Mapper::Mapper(const MapperOptions& opts) : m_opts(opts)
 {
+	if (m_opts.snapshotEvery > 1000000)
+		throw ConfigError("--snapshot-every=" + std::to_string(m_opts.snapshotEvery) + " is out of range [0, 1000000]");
 	if (m_opts.localCells < 10 || m_opts.localCells > 100000)
 		throw ConfigError("--local-size-cells=" + std::to_string(m_opts.localCells) + " is out of range [10, 100000]");
 	mrpt::config::CConfigFileMemory ini(m_opts.configText);
@@ -188,6 +193,18 @@ RunSummary Mapper::run()
 	planes << "frame,a,b,c,d,nodes,status,mount_z,mount_pitch_deg,mount_roll_deg,mount_alarm\n";
 	planes << std::setprecision(9);
 	timing << std::fixed << std::setprecision(4);
+	// Snapshots (--snapshot-every N): written into the temporary folder too,
+	// published with the rest.
+	const std::string snapDir = tmp.path + "/snapshots";
+	std::ofstream snapIndex;
+	if (m_opts.snapshotEvery)
+	{
+		fs::create_directory(snapDir, ec);
+		snapIndex.open(snapDir + "/index.csv");
+		if (!snapIndex) throw RunError("cannot write to " + snapDir);
+		snapIndex << "snapshot,frames,frame_index,rawlog_entry,robot_x,robot_y,robot_yaw_deg\n";
+		snapIndex << std::fixed << std::setprecision(6);
+	}
 
 	s.maps.resize(m_specs.size());
 	for (size_t i = 0; i < m_specs.size(); i++)
@@ -286,6 +303,23 @@ RunSummary Mapper::run()
 					if (traits[i] && traits[i]->keepWindow)
 						traits[i]->keepWindow(*m_maps.maps[i], fr.robotPose.x(), fr.robotPose.y(), m_opts.localCells);
 
+			if (m_opts.snapshotEvery && s.frames % m_opts.snapshotEvery == 0)
+			{
+				char name[32];
+				std::snprintf(name, sizeof(name), "%06zu", s.frames);
+				try
+				{
+					writeSnapshot(snapDir + "/" + name);
+				}
+				catch (const std::exception& e)
+				{
+					throw RunError("writing snapshot " + std::string(name) + ": " + conciseError(e.what()));
+				}
+				snapIndex << name << "," << s.frames << "," << fr.index << "," << fr.entry << "," << fr.robotPose.x()
+						  << "," << fr.robotPose.y() << "," << mrpt::RAD2DEG(fr.robotPose.yaw()) << "\n";
+				s.snapshots++;
+			}
+
 			if (m_opts.progress)
 			{
 				const auto now = clk::now();
@@ -324,6 +358,11 @@ RunSummary Mapper::run()
 	timing.close();
 	planes.close();
 	if (!timing || !planes) throw RunError("cannot write timing.csv / ground_planes.csv in " + tmp.path);
+	if (m_opts.snapshotEvery)
+	{
+		snapIndex.close();
+		if (!snapIndex) throw RunError("cannot write " + snapDir + "/index.csv");
+	}
 
 	// 4. Maps.
 	try
@@ -346,6 +385,14 @@ RunSummary Mapper::run()
 	{
 		fs::rename(fs::path(tmp.path) / f, fs::path(m_opts.outDir) / f, ec);
 		if (ec) throw RunError("cannot move " + f + " into " + m_opts.outDir + ": " + ec.message());
+	}
+	if (m_opts.snapshotEvery)
+	{
+		// The snapshots of an earlier run go only now, replaced as a whole.
+		const fs::path dst = fs::path(m_opts.outDir) / "snapshots";
+		fs::remove_all(dst, ec);
+		fs::rename(snapDir, dst, ec);
+		if (ec) throw RunError("cannot move snapshots into " + m_opts.outDir + ": " + ec.message());
 	}
 	s.seconds = std::chrono::duration<double>(clk::now() - tStart).count();
 	return s;

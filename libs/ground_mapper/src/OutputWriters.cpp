@@ -49,4 +49,15 @@ void Mapper::writeMaps(const std::string& dir, RunSummary& s)
 	}
 }
 
+void Mapper::writeSnapshot(const std::string& dir) const
+{
+	fs::create_directories(dir);
+	for (size_t i = 0; i < m_specs.size(); i++)
+		if (const auto* g = dynamic_cast<const mrpt::maps::COccupancyGridMap2D*>(m_maps.maps[i].get()))
+		{
+			const std::string L = m_specs[i].label;
+			gam::maps::writeRosMap(*g, dir + "/" + L + ".yaml", dir + "/" + L + ".pgm", L + ".pgm");
+		}
+}
+
 }  // namespace gam::mapper

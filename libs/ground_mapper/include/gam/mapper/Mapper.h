@@ -37,6 +37,11 @@ struct MapperOptions
 	bool localMap = false;
 	int localCells = 600;
 	size_t maxFrames = 0;  ///< 0 = all
+	/** > 0: after every N-th frame, the map_server maps (`<label>.yaml` + `.pgm`)
+	 * of every 2D grid as they are after that frame, in
+	 * `outDir/snapshots/NNNNNN/` (NNNNNN = frames inserted so far), plus
+	 * `outDir/snapshots/index.csv`. Published with the other outputs. */
+	size_t snapshotEvery = 0;
 	bool progress = true;
 	/** If set, checked before every frame: non-zero stops the run (RunError
 	 * "interrupted"; nothing is published in outDir). For SIGINT/SIGTERM handlers. */
@@ -88,6 +93,7 @@ struct MapTiming
 struct RunSummary
 {
 	size_t frames = 0, frames3D = 0, frames2D = 0, framesWithoutOdometry = 0;
+	size_t snapshots = 0;  ///< folders written under snapshots/ (MapperOptions::snapshotEvery)
 	double seconds = 0;
 	std::vector<MapTiming> maps;
 	std::vector<std::string> files;  ///< written, relative to outDir
@@ -112,6 +118,8 @@ class Mapper
 
    private:
 	void writeMaps(const std::string& tmpDir, RunSummary& s);
+	/** The map_server maps of every 2D grid into `dir` (created). Throws std::runtime_error. */
+	void writeSnapshot(const std::string& dir) const;
 	MapperOptions m_opts;
 	mrpt::maps::CMultiMetricMap m_maps;
 	std::vector<MapSpec> m_specs;
