@@ -88,13 +88,20 @@ void run(const Scene& scene, Result& out, MissingFloorParams p = {})
 uint32_t cellOf(int ix, int iy) { return uint32_t(iy * 20 + ix); }
 }  // namespace
 
-TEST(MissingFloor, EmptyCellChanceIsQToTheN)
+TEST(MissingFloor, EmptyCellChance)
 {
-	// Floor that drops 4 % of its rays leaves 16 rays all empty with 0.04^16.
-	EXPECT_NEAR(missing::emptyCellChance(0.04, 16), std::pow(0.04, 16), 1e-30);
-	EXPECT_DOUBLE_EQ(missing::emptyCellChance(0.5, 3), 0.125);
-	EXPECT_DOUBLE_EQ(missing::emptyCellChance(1.0, 50), 1.0);  // all floor drops: no evidence
-	EXPECT_DOUBLE_EQ(missing::emptyCellChance(0.3, 0), 1.0);
+	// Independent dropouts (p11 = q, or unknown: -1): floor that drops 4 % of
+	// its rays leaves 16 rays all empty with 0.04^16.
+	EXPECT_NEAR(missing::emptyCellChance(0.04, -1, 16), std::pow(0.04, 16), 1e-30);
+	EXPECT_DOUBLE_EQ(missing::emptyCellChance(0.5, 0.5, 3), 0.125);
+	EXPECT_DOUBLE_EQ(missing::emptyCellChance(1.0, -1, 50), 1.0);  // all floor drops: no evidence
+	EXPECT_DOUBLE_EQ(missing::emptyCellChance(0.3, -1, 0), 1.0);
+	// Blocky dropouts: 4 % of the rays empty, but 9 in 10 neighbours of an
+	// empty ray empty too: 0.04 * 0.9^15 = 0.04 * 0.205891 = 0.0082356.
+	EXPECT_NEAR(missing::emptyCellChance(0.04, 0.9, 16), 0.04 * std::pow(0.9, 15), 1e-12);
+	EXPECT_NEAR(missing::emptyCellChance(0.04, 0.9, 16), 0.0082356, 1e-6);
+	// Anti-correlated (p11 < q) is not trusted: q^n.
+	EXPECT_DOUBLE_EQ(missing::emptyCellChance(0.5, 0.1, 3), 0.125);
 }
 
 TEST(MissingFloor, DarkHoleInSeenFloorIsMarked)
@@ -117,6 +124,8 @@ TEST(MissingFloor, DarkHoleInSeenFloorIsMarked)
 	EXPECT_EQ(res.stats.rays, 1600u);
 	EXPECT_EQ(res.stats.empty_rays, 64u);
 	EXPECT_NEAR(res.det.dropoutRate(1.0), 64.0 / 1600.0, 1e-12);  // q = 0.04
+	// No empty ray lies on seen floor: no neighbour statistics (independent).
+	EXPECT_EQ(res.det.neighbourDropoutRate(), -1);
 	// Each hole cell: 16 empty rays, 0.04^16 = 4e-23 << alpha = 1e-3.
 	for (int ix : {9, 10})
 		for (int iy : {7, 8})
@@ -172,7 +181,7 @@ TEST(MissingFloor, FloorThatDropsOutOftenIsNotAHole)
 	const double q = 1444.0 / 1600.0;  // 0.9025
 	EXPECT_NEAR(res.det.dropoutRate(1.0), q, 1e-12);
 	// 0.9025^16 = 0.194: such floor often leaves a cell empty -> not missing.
-	EXPECT_GT(missing::emptyCellChance(q, 16), 1e-3);
+	EXPECT_GT(missing::emptyCellChance(q, -1, 16), 1e-3);
 	EXPECT_EQ(res.det.emptyRays(cellOf(14, 14)), 16);
 	EXPECT_FALSE(res.det.isMissing(cellOf(14, 14)));
 	EXPECT_EQ(res.det.emptyRays(cellOf(12, 13)), 16);  // cols 4-7 (y cell 13): all empty
@@ -180,20 +189,71 @@ TEST(MissingFloor, FloorThatDropsOutOftenIsNotAHole)
 	EXPECT_EQ(res.stats.cells, 0u);
 }
 
+TEST(MissingFloor, BlockyDropoutsOnSeenFloorAreNotAHole)
+{
+	// A structured-light camera loses whole blocks: rows 8-15 lose columns
+	// 1-14. Rows 8-11 are x cell 12 and rows 12-15 x cell 11; the y index is
+	// floor(10 + (19.5 - c) / 4): cols 0-3 -> 14, 4-7 -> 13, 8-11 -> 12,
+	// 12-15 -> 11. So cells (11..12, 12..13) are entirely empty, while y cells
+	// 14 (col 0 returns) and 11 (col 15 returns) are seen floor with empty
+	// rays. Pairs of neighbours on seen floor, per row: (1,2), (2,3), (12,13),
+	// (13,14) both empty, (14,15) empty then valid ((3,4) and (11,12) touch an
+	// unseen cell): p11 = 4 / 5 = 0.8. q = 8 * 14 / 1600 = 0.07. A fully
+	// empty cell: 0.07 * 0.8^15 = 0.07 * 0.035184 = 0.0024629 > alpha = 1e-3:
+	// blocky dropouts, not a hole.
+	Scene s;
+	for (int r = 8; r < 16; r++)
+		for (int c = 1; c < 15; c++) s.at(r, c) = 0;
+	Result res;
+	run(s, res);
+	EXPECT_EQ(res.stats.empty_rays, 112u);
+	EXPECT_DOUBLE_EQ(res.det.neighbourDropoutRate(), 0.8);
+	EXPECT_NEAR(missing::emptyCellChance(0.07, 0.8, 16), 0.0024629, 1e-6);
+	for (int ix : {11, 12})
+		for (int iy : {12, 13})
+		{
+			EXPECT_EQ(res.det.emptyRays(cellOf(ix, iy)), 16) << ix << "," << iy;
+			EXPECT_FALSE(res.det.isMissing(cellOf(ix, iy))) << ix << "," << iy;
+		}
+	EXPECT_EQ(res.stats.cells, 0u);
+	// The same empty block with independent dropouts would be a hole:
+	// 0.07^16 = 3.3e-19.
+	EXPECT_LT(missing::emptyCellChance(0.07, -1, 16), 1e-3);
+}
+
 TEST(MissingFloor, ReturnsFarBelowTheFloorCountAsNoFloor)
 {
 	// A hole deeper than the range: the camera returns 6 m where the floor is
 	// at 1 m (beyond the 4.5 m range and more than the 0.10 m margin below the
-	// floor) -> empty rays: rows and cols 16-23 are x and y cells 9 and 10.
+	// floor) -> empty rays: rows 16-23 and cols 24-31 are x cells 9, 10 and
+	// y cells 7, 8 (as the dark hole above).
 	Scene s;
 	for (int r = 16; r < 24; r++)
-		for (int c = 16; c < 24; c++) s.at(r, c) = 6000;
+		for (int c = 24; c < 32; c++) s.at(r, c) = 6000;
 	Result res;
 	run(s, res);
 	EXPECT_EQ(res.stats.empty_rays, 64u);
 	EXPECT_EQ(res.stats.cells, 4u);
-	EXPECT_TRUE(res.det.isMissing(cellOf(9, 9)));
-	EXPECT_TRUE(res.det.isMissing(cellOf(10, 10)));
+	EXPECT_TRUE(res.det.isMissing(cellOf(9, 7)));
+	EXPECT_TRUE(res.det.isMissing(cellOf(10, 8)));
+}
+
+TEST(MissingFloor, WhereTheReturnsStopIsNotAHole)
+{
+	// Rows 0-7 return nothing: x cells 13 and 14, the far edge of the view
+	// (as a range cutoff, or an image border the camera does not fill). Floor
+	// is seen nearer (x cell 12) but nothing beyond: not a gap in the floor.
+	// (q = 320 / 1600 = 0.2 and 0.2^16 = 6.6e-12 would pass the cell test.)
+	Scene s;
+	for (int r = 0; r < 8; r++)
+		for (int c = 0; c < kSize; c++) s.at(r, c) = 0;
+	Result res;
+	run(s, res);
+	EXPECT_EQ(res.stats.empty_rays, 320u);
+	EXPECT_GT(res.stats.candidates, 0u);
+	EXPECT_EQ(res.stats.cells, 0u);
+	EXPECT_EQ(res.stats.unbordered, 1u);
+	EXPECT_FALSE(res.det.isMissing(cellOf(14, 10)));
 }
 
 TEST(MissingFloor, NoSeenFloorAroundMeansNoRegion)

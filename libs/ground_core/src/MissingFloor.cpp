@@ -5,17 +5,16 @@
 
 namespace gam
 {
-void MissingFloorParams::validate() const
-{
-	checkParamRanges(*this, "");
-}
+void MissingFloorParams::validate() const { checkParamRanges(*this, ""); }
 
 namespace missing
 {
-double emptyCellChance(double q, int n)
+double emptyCellChance(double q, double p11, int n)
 {
 	if (n <= 0) return 1.0;
-	return std::pow(std::clamp(q, 0.0, 1.0), n);
+	q = std::clamp(q, 0.0, 1.0);
+	const double next = std::max(q, std::min(p11, 1.0));
+	return q * std::pow(next, n - 1);
 }
 }  // namespace missing
 
@@ -29,6 +28,7 @@ void MissingFloorDetector::clear()
 	m_touched.clear();
 	m_cells.clear();
 	m_blocking.clear();
+	m_p11 = -1;
 	std::fill(m_binRays.begin(), m_binRays.end(), 0u);
 	std::fill(m_binEmpty.begin(), m_binEmpty.end(), 0u);
 }
@@ -89,13 +89,19 @@ void MissingFloorDetector::compute(
 	const int step = std::max(1, decimation);
 
 	// 1. Every pixel whose ray meets the ground inside the range: one ray of
-	// the cell it meets; empty if the camera returned nothing there.
+	// the cell it meets; empty if the camera returned nothing there. Along
+	// each row, pairs of neighbours that both meet seen floor give p11.
+	size_t pairsAfterEmpty = 0, pairsBothEmpty = 0;
 	for (int r = 0; r < img.rows; r += step)
+	{
+		int prev = 0;  // previous pixel of the row: 0 none, 1 seen floor, 2 empty on seen floor
 		for (int c = 0; c < img.cols; c += step)
 		{
+			const int before = prev;
+			prev = 0;
 			const Eigen::Vector2f f = projector.rayFactor(r, c);
 			const double down = nr.x() + nr.y() * f.x() + nr.z() * f.y();
-			if (!(down < 0)) continue;  // parallel to the ground or rising
+			if (!(down < 0)) continue;   // parallel to the ground or rising
 			const double t = -h / down;  // depth at which the ray meets the ground
 			const double norm = img.is_depth ? 1.0 : std::sqrt(1.0 + double(f.x()) * f.x() + double(f.y()) * f.y());
 			const double expected = t * norm;  // in the image's own measure
@@ -109,13 +115,24 @@ void MissingFloorDetector::compute(
 			const size_t bin = size_t(expected / m_params.range_bin);
 			m_binRays[bin]++;
 			stats.rays++;
+			const uint32_t cell = uint32_t(g.index(cx, cy));
+			if (grid.cell(cell).count > 0)
+			{
+				prev = empty ? 2 : 1;
+				if (before == 2)
+				{
+					pairsAfterEmpty++;
+					if (empty) pairsBothEmpty++;
+				}
+			}
 			if (!empty) continue;
 			m_binEmpty[bin]++;
 			stats.empty_rays++;
-			const uint32_t cell = uint32_t(g.index(cx, cy));
 			if (m_empty[cell] == 0) m_touched.push_back(cell);
 			if (m_empty[cell] < 65535) m_empty[cell]++;
 		}
+	}
+	if (pairsAfterEmpty) m_p11 = double(pairsBothEmpty) / double(pairsAfterEmpty);
 
 	// 2. Candidate cells: nothing was seen there, and floor with the dropout
 	// rate measured at that range would rarely leave so many rays empty.
@@ -129,13 +146,21 @@ void MissingFloorDetector::compute(
 		if (std::abs(n.z()) < 1e-9) continue;
 		const Eigen::Vector3d pc(x, y, -(n.x() * x + n.y() * y + d) / n.z());
 		const double depth = img.is_depth ? (pc - s).dot(xAxis) : (pc - s).norm();
-		if (missing::emptyCellChance(dropoutRate(depth), n_) > m_params.alpha) continue;
+		if (missing::emptyCellChance(dropoutRate(depth), m_p11, n_) > m_params.alpha) continue;
 		m_mark[cell] = kCandidate;
 		stats.candidates++;
 	}
 
-	// 3. Connected regions of candidates (8-neighbours) that border seen floor.
+	// 3. Connected regions of candidates (8-neighbours) with seen floor next
+	// to them along the rays both nearer to the sensor and farther away: a gap
+	// inside the floor. A gap with no floor beyond it is where the returns stop (a range
+	// cutoff, the edge of the view); one with no floor before it is where they
+	// start (the robot's own body, the near limit).
 	const double block2 = m_params.block_range * m_params.block_range;
+	const auto dist2 = [&](int cx, int cy) {
+		const double dx = g.cx(cx) - s.x(), dy = g.cy(cy) - s.y();
+		return dx * dx + dy * dy;
+	};
 	for (uint32_t seed : m_touched)
 	{
 		if (m_mark[seed] != kCandidate) continue;
@@ -143,12 +168,24 @@ void MissingFloorDetector::compute(
 		m_queue.clear();
 		m_queue.push_back(seed);
 		m_mark[seed] |= kVisited;
-		bool bordered = false;
+		bool nearer = false, farther = false;
 		for (size_t qi = 0; qi < m_queue.size(); qi++)
 		{
 			const uint32_t c = m_queue[qi];
 			m_region.push_back(c);
 			const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
+			// The cells one step nearer and one step farther along the ray
+			// from the sensor through this cell.
+			const double ux = g.cx(cx) - s.x(), uy = g.cy(cy) - s.y();
+			const double len = std::sqrt(ux * ux + uy * uy);
+			if (len > 0)
+				for (int side : {-1, 1})
+				{
+					const double k = side * g.resolution / len;
+					const int ax = g.ix(g.cx(cx) + k * ux), ay = g.iy(g.cy(cy) + k * uy);
+					if (!g.inside(ax, ay) || classes[g.index(ax, ay)] != VoxelClass::Ground) continue;
+					(side < 0 ? nearer : farther) = true;
+				}
 			for (int dy = -1; dy <= 1; dy++)
 				for (int dx = -1; dx <= 1; dx++)
 				{
@@ -156,7 +193,6 @@ void MissingFloorDetector::compute(
 					const int ax = cx + dx, ay = cy + dy;
 					if (!g.inside(ax, ay)) continue;
 					const uint32_t a = uint32_t(g.index(ax, ay));
-					if (classes[a] == VoxelClass::Ground) bordered = true;
 					if (m_mark[a] == kCandidate)
 					{
 						m_mark[a] |= kVisited;
@@ -164,6 +200,7 @@ void MissingFloorDetector::compute(
 					}
 				}
 		}
+		const bool bordered = nearer && farther;
 		if (!bordered)
 		{
 			stats.unbordered++;
@@ -174,9 +211,7 @@ void MissingFloorDetector::compute(
 		{
 			m_mark[c] = kMissing;
 			m_cells.push_back(c);
-			const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
-			const double dx = g.cx(cx) - s.x(), dy = g.cy(cy) - s.y();
-			if (dx * dx + dy * dy <= block2) m_blocking.push_back(c);
+			if (dist2(int(c % uint32_t(g.nx)), int(c / uint32_t(g.nx))) <= block2) m_blocking.push_back(c);
 		}
 	}
 	stats.cells = m_cells.size();

@@ -1,3 +1,4 @@
+#include <gam/maps/GridIO.h>
 #include <gam/maps/IniFields.h>
 #include <gam/maps/MapRegistry.h>
 #include <gam/maps/ObservationAdapters.h>
@@ -29,8 +30,21 @@ const bool kTraitsRegistered = [] {
 		{"_insertOpts", {}},
 		{"_likelihoodOpts", {}},
 		{"_groundOpts", gam::maps::ini::keys<CGroundAwareOccupancyGrid::TGroundAwareOptions>()}};
-	t.writeOutputs = gam::maps::writeGridOutputs;
-	t.keepWindow = gam::maps::keepGridWindow;
+	t.writeOutputs = [](CMetricMap& m, const gam::maps::OutputContext& ctx, std::vector<std::string>& files) {
+		gam::maps::writeGridOutputs(m, ctx, files);
+		// The missing-floor layer as its own map_server pair and PNG (after
+		// writeGridOutputs, which crops a local map: the layer follows).
+		const auto& g = dynamic_cast<const CGroundAwareOccupancyGrid&>(m);
+		COccupancyGridMap2D layer = g.missingFloorLayer();
+		const std::string stem = ctx.label + "_missing_floor", base = ctx.dir + "/" + stem;
+		gam::maps::writeRosMap(layer, base + ".yaml", base + ".pgm", stem + ".pgm");
+		gam::maps::writeGridPng(layer, base + ".png");
+		for (const char* ext : {".yaml", ".pgm", ".png"}) files.push_back(stem + ext);
+	};
+	t.keepWindow = [](CMetricMap& m, double x, double y, int cells) {
+		// The layer follows the grid's window (missingFloorLayer() re-syncs it).
+		gam::maps::keepGridWindow(m, x, y, cells);
+	};
 	t.stageTimes = [](const CMetricMap& m, bool depthFrame, const gam::maps::StageSink& sink) {
 		const auto& g = dynamic_cast<const CGroundAwareOccupancyGrid&>(m);
 		if (!depthFrame || !g.lastFrame().valid) return;
@@ -305,24 +319,61 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 	return true;
 }
 
+void CGroundAwareOccupancyGrid::syncMissingLayer() const
+{
+	COccupancyGridMap2D& L = m_missingLayer;
+	if (L.getSizeX() == getSizeX() && L.getSizeY() == getSizeY() && L.getXMin() == getXMin() &&
+		L.getYMin() == getYMin() && L.getResolution() == getResolution())
+		return;
+	// Same lattice as this grid (MRPT keeps the alignment when a grid grows or
+	// is recentred): copy the cells both cover.
+	COccupancyGridMap2D fresh(getXMin(), getXMax(), getYMin(), getYMax(), getResolution());
+	if (L.getSizeX() && L.getSizeY())
+		for (unsigned cy = 0; cy < L.getSizeY(); cy++)
+			for (unsigned cx = 0; cx < L.getSizeX(); cx++)
+			{
+				const int nx = fresh.x2idx(L.idx2x(cx)), ny = fresh.y2idx(L.idx2y(cy));
+				if (nx < 0 || ny < 0 || nx >= int(fresh.getSizeX()) || ny >= int(fresh.getSizeY())) continue;
+				fresh.getRow(ny)[nx] = L.getRow(int(cy))[cx];
+			}
+	L = std::move(fresh);
+}
+
+const COccupancyGridMap2D& CGroundAwareOccupancyGrid::missingFloorLayer() const
+{
+	syncMissingLayer();
+	return m_missingLayer;
+}
+
+bool CGroundAwareOccupancyGrid::isMissingFloor(float x, float y) const
+{
+	const COccupancyGridMap2D& L = missingFloorLayer();
+	const int cx = L.x2idx(x), cy = L.y2idx(y);
+	if (cx < 0 || cy < 0 || cx >= int(L.getSizeX()) || cy >= int(L.getSizeY())) return false;
+	return L.getCell(unsigned(cx), unsigned(cy)) < 0.5f;
+}
+
 void CGroundAwareOccupancyGrid::applyEvidence()
 {
 	const gam::InverseSensorModel& ism = m_pipeline.ism();
+	const gam::MissingFloorDetector& missing = m_pipeline.missingFloor();
 	const auto& cells = ism.evidenceCells();
-	if (cells.empty()) return;
+	const auto& missingCells = missing.cells();
+	if (cells.empty() && missingCells.empty()) return;
 	const auto& ev = ism.evidence();
 	const auto& g = m_pipeline.frameGrid().geometry();
 
 	// Grow the grid to hold the evidence (MRPT keeps the cell alignment).
 	int x0 = g.nx, x1 = -1, y0 = g.ny, y1 = -1;
-	for (uint32_t c : cells)
-	{
+	const auto extend = [&](uint32_t c) {
 		const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
 		x0 = std::min(x0, cx);
 		x1 = std::max(x1, cx);
 		y0 = std::min(y0, cy);
 		y1 = std::max(y1, cy);
-	}
+	};
+	for (uint32_t c : cells) extend(c);
+	for (uint32_t c : missingCells) extend(c);
 	const float bx0 = float(g.x_min + x0 * g.resolution), bx1 = float(g.x_min + (x1 + 1) * g.resolution);
 	const float by0 = float(g.y_min + y0 * g.resolution), by1 = float(g.y_min + (y1 + 1) * g.resolution);
 	if (bx0 < getXMin() || bx1 > getXMax() || by0 < getYMin() || by1 > getYMax())
@@ -339,18 +390,44 @@ void CGroundAwareOccupancyGrid::applyEvidence()
 			0.5f, true);
 
 	// Log-odds fusion: each cell gets one update per frame. MRPT cells hold
-	// the log-odds of being FREE, so occupied evidence lowers them.
+	// the log-odds of being FREE, so occupied evidence lowers them. Missing
+	// floor within the block range is obstacle evidence of the obstacle gain
+	// (eq. 5 at full density confidence), combined with the ISM's.
+	const float pMissing = float(0.5 + 0.5 * m_options.pipeline.ism.K_m);
+	const auto blocks = [&](uint32_t c) {
+		if (!missing.isMissing(c)) return false;
+		const double dx = g.cx(int(c % uint32_t(g.nx))) - lastFrame().sensor.x();
+		const double dy = g.cy(int(c / uint32_t(g.nx))) - lastFrame().sensor.y();
+		const double r = m_options.pipeline.missing.block_range;
+		return dx * dx + dy * dy <= r * r;
+	};
 	const int sx = int(getSizeX()), sy = int(getSizeY());
-	for (uint32_t c : cells)
-	{
+	const auto update = [&](uint32_t c, float pOcc) {
 		const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
 		const int wx = x2idx(g.cx(cx)), wy = y2idx(g.cy(cy));
-		if (wx < 0 || wy < 0 || wx >= sx || wy >= sy) continue;
-		const float pFree = std::clamp(1.0f - ev[c], gam::ism::kEvidenceFloor, 1.0f - gam::ism::kEvidenceFloor);
+		if (wx < 0 || wy < 0 || wx >= sx || wy >= sy) return;
+		const float pFree = std::clamp(1.0f - pOcc, gam::ism::kEvidenceFloor, 1.0f - gam::ism::kEvidenceFloor);
 		const int l = int(p2l(pFree));
 		cellType& cell = m_map[size_t(wx) + size_t(wy) * getSizeX()];
 		cell = cellType(std::clamp(int(cell) + l, int(OCCGRID_CELLTYPE_MIN), int(OCCGRID_CELLTYPE_MAX)));
-	}
+	};
+	for (uint32_t c : cells) update(c, blocks(c) ? gam::ism::combine(ev[c], pMissing) : ev[c]);
+	for (uint32_t c : missingCells)
+		if (ev[c] == 0.5f && blocks(c)) update(c, pMissing);
+
+	// The missing-floor layer: this frame's judgement replaces the old one;
+	// floor seen clears a cell.
+	syncMissingLayer();
+	const auto& cls = ism.classes();
+	const auto setLayer = [&](uint32_t c, float pFree) {
+		const int wx = m_missingLayer.x2idx(g.cx(int(c % uint32_t(g.nx))));
+		const int wy = m_missingLayer.y2idx(g.cy(int(c / uint32_t(g.nx))));
+		if (wx < 0 || wy < 0 || wx >= sx || wy >= sy) return;
+		m_missingLayer.setCell(unsigned(wx), unsigned(wy), pFree);
+	};
+	for (uint32_t c : cells)
+		if (c < cls.size() && cls[c] == gam::VoxelClass::Ground) setLayer(c, 1.0f);
+	for (uint32_t c : missingCells) setLayer(c, 0.0f);
 	m_is_empty = false;
 	m_likelihoodCacheOutDated = true;
 }
@@ -358,26 +435,33 @@ void CGroundAwareOccupancyGrid::applyEvidence()
 // ---------------------------------------------------------------------------
 // Serialization: v0 = base grid (with its own version) + groundOptions as
 // (key, value) pairs, so options added later read back old files.
-uint8_t CGroundAwareOccupancyGrid::serializeGetVersion() const { return 0; }
+// v1 = v0 + the missing-floor layer (a plain COccupancyGridMap2D).
+uint8_t CGroundAwareOccupancyGrid::serializeGetVersion() const { return 1; }
 
 void CGroundAwareOccupancyGrid::serializeTo(mrpt::serialization::CArchive& out) const
 {
 	out << COccupancyGridMap2D::serializeGetVersion();
 	COccupancyGridMap2D::serializeTo(out);
 	gam::maps::ini::write(m_options, out);
+	syncMissingLayer();
+	out << m_missingLayer;
 }
 
 void CGroundAwareOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version)
 {
 	switch (version)
 	{
-		case 0: {
+		case 0:
+		case 1: {
 			uint8_t baseVer;
 			in >> baseVer;
 			COccupancyGridMap2D::serializeFrom(in, baseVer);
 			TGroundAwareOptions o;
 			gam::maps::ini::read(o, in, "CGroundAwareOccupancyGrid");
 			setGroundOptions(o);
+			m_missingLayer = COccupancyGridMap2D(getXMin(), getXMax(), getYMin(), getYMax(), getResolution());
+			if (version >= 1) in >> m_missingLayer;
+			syncMissingLayer();
 		}
 		break;
 		default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);

@@ -31,6 +31,37 @@ bool categoryFromName(const std::string& s, Category& c)
 	return false;
 }
 
+const char* materialName(Material m)
+{
+	switch (m)
+	{
+		case Material::Normal: return "normal";
+		case Material::Absorbing: return "absorbing";
+		case Material::Transparent: return "transparent";
+		case Material::Specular: return "specular";
+	}
+	return "?";
+}
+
+bool materialFromName(const std::string& s, Material& m)
+{
+	for (int i = 0; i <= 3; i++)
+		if (s == materialName(Material(i)))
+		{
+			m = Material(i);
+			return true;
+		}
+	return false;
+}
+
+bool FloorPatch::containsXY(double x, double y) const
+{
+	const double c = std::cos(yaw), s = std::sin(yaw);
+	const double dx = x - cx, dy = y - cy;
+	const double lx = c * dx + s * dy, ly = -s * dx + c * dy;
+	return std::abs(lx) <= hx && std::abs(ly) <= hy;
+}
+
 Pose3 Pose3::fromXYZYPR(double x, double y, double z, double yaw, double pitch, double roll)
 {
 	Pose3 p;
@@ -293,6 +324,13 @@ bool Scene::castGround(const Eigen::Vector3d& o, const Eigen::Vector3d& dir, dou
 			h.point = o + t * dir;
 			h.normal = nrm;
 			h.object_id = hitObj;
+			if (hitObj == 0)
+				for (const auto& fp : floor_patches)
+					if (fp.containsXY(h.point.x(), h.point.y()))
+					{
+						h.object_id = fp.object_id;
+						break;
+					}
 			return true;
 		}
 		Eigen::Vector3d n2;
@@ -313,6 +351,7 @@ RayHit Scene::cast(const Eigen::Vector3d& o, const Eigen::Vector3d& dir, double 
 	const Eigen::Vector3d inv(1.0 / dir.x(), 1.0 / dir.y(), 1.0 / dir.z());
 	for (const auto& s : solids)
 	{
+		if (s.transparent) continue;  // clear glass / plastic: the light passes
 		// slab test against the bounding box first
 		double t0 = tmin, t1 = tmax;
 		bool miss = false;
@@ -368,6 +407,13 @@ const ObjectInfo* Scene::object(int id) const
 	for (const auto& o : objects)
 		if (o.id == id) return &o;
 	return nullptr;
+}
+
+Material Scene::materialOf(int id) const
+{
+	if (id == 0) return Material::Normal;
+	const ObjectInfo* o = object(id);
+	return o ? o->material : Material::Normal;
 }
 
 Eigen::AlignedBox3d Scene::bounds() const

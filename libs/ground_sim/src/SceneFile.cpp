@@ -146,6 +146,14 @@ ObjectInfo& beginObject(SceneBuilder& b, Args& a, const std::string& type)
 		if (!categoryFromName(a.str("category"), oi.category)) a.fail("unknown category '" + a.str("category") + "'");
 		oi.category_given = true;
 	}
+	if (a.has("material"))
+	{
+		if (!materialFromName(a.str("material"), oi.material))
+			a.fail("unknown material '" + a.str("material") + "' (normal, absorbing, transparent, specular)");
+	}
+	oi.dropout = a.num("dropout", oi.material == Material::Specular ? 0.5 : 0.0);
+	if (!(oi.dropout >= 0 && oi.dropout <= 1)) a.fail("dropout must be in [0,1]");
+	if (oi.dropout > 0 && oi.material != Material::Specular) a.fail("dropout= needs material=specular");
 	b.sf.scene.objects.push_back(oi);
 	return b.sf.scene.objects.back();
 }
@@ -231,6 +239,24 @@ void parseHole(SceneBuilder& b, Args& a)
 	else
 		a.fail("shape must be rect or circle");
 	b.sf.scene.holes.push_back(h);
+}
+
+void parseFloorPatch(SceneBuilder& b, Args& a)
+{
+	ObjectInfo& oi = beginObject(b, a, "floor_patch");
+	if (oi.material == Material::Transparent) a.fail("a floor patch cannot be transparent");
+	if (!oi.category_given) oi.category = Category::None;  // still floor
+	FloorPatch fp;
+	fp.object_id = oi.id;
+	fp.cx = a.req("x");
+	fp.cy = a.req("y");
+	fp.hx = 0.5 * a.pos("sx", 0, true);
+	fp.hy = 0.5 * a.pos("sy", 0, true);
+	fp.yaw = a.num("yaw", 0) * kDeg;
+	oi.bbox = Eigen::AlignedBox3d(
+		Eigen::Vector3d(fp.cx - std::hypot(fp.hx, fp.hy), fp.cy - std::hypot(fp.hx, fp.hy), 0),
+		Eigen::Vector3d(fp.cx + std::hypot(fp.hx, fp.hy), fp.cy + std::hypot(fp.hx, fp.hy), 0));
+	b.sf.scene.floor_patches.push_back(fp);
 }
 
 void parseBox(SceneBuilder& b, Args& a)
@@ -469,6 +495,7 @@ constexpr Statement kStatements[] = {
 	{"leddar", parseLeddar},
 	{"hole", parseHole},
 	{"box", parseBox},
+	{"floor_patch", parseFloorPatch},
 	{"wall", parseWall},
 	{"stairs_down", parseStairsDown},
 	{"stairs_up", parseStairsUp},
@@ -510,7 +537,15 @@ SceneFile parseScene(std::istream& in, const std::string& filename)
 		if (!st) throw SceneError(where + ": unknown statement '" + kw + "'");
 		const size_t s0 = sc.solids.size(), h0 = sc.holes.size();
 		st->parse(b, a);
-		if (!sc.objects.empty() && sc.solids.size() + sc.holes.size() != s0 + h0) finishObject(sc, s0, h0);
+		if (!sc.objects.empty() && sc.solids.size() + sc.holes.size() != s0 + h0)
+		{
+			finishObject(sc, s0, h0);
+			// The parts of a transparent object let the light through.
+			if (sc.objects.back().material == Material::Transparent)
+				for (size_t i = s0; i < sc.solids.size(); i++) sc.solids[i].transparent = true;
+			if (sc.objects.back().material == Material::Transparent && sc.holes.size() != h0)
+				throw SceneError(where + ": a hole cannot be transparent");
+		}
 		a.finish();
 	}
 	SceneFile& sf = b.sf;

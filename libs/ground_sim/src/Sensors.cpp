@@ -112,13 +112,24 @@ DepthFrame KinectModel::render(const Scene& scene, const Pose3& sensor, std::mt1
 			}
 		}
 
-	// 3) noise, dropouts, flying pixels, spikes
+	// 3) materials, noise, dropouts, flying pixels, spikes
 	std::normal_distribution<double> gauss(0.0, 1.0);
 	std::uniform_real_distribution<double> uni(0.0, 1.0);
 	for (size_t i = 0; i < N; i++)
 	{
 		const double z = f.true_depth[i];
 		double d = z;
+		if (f.object_id[i] != 0 && std::isfinite(z))
+		{
+			// Absorbing surfaces return nothing; shiny ones drop out at random.
+			const ObjectInfo* oi = scene.object(f.object_id[i]);
+			const Material m = oi ? oi->material : Material::Normal;
+			if (m == Material::Absorbing || (m == Material::Specular && p.noise && uni(rng) < oi->dropout))
+			{
+				f.flags[i] |= PixDropout;
+				continue;
+			}
+		}
 		if (p.noise)
 		{
 			if (f.flags[i] & PixEdge)
@@ -181,6 +192,7 @@ LeddarScan LeddarModel::scan(const Scene& scene, const Pose3& sensor, std::mt199
 				const double v = -0.5 * vf + (b + 0.5) * vf / p.sub_v;
 				const Eigen::Vector3d dl(std::cos(v) * std::cos(h), std::cos(v) * std::sin(h), std::sin(v));
 				const RayHit hit = scene.cast(sensor.t, sensor.R * dl, 1e-6, p.max_range);
+				if (hit.hit && scene.materialOf(hit.object_id) == Material::Absorbing) continue;  // no echo
 				if (hit.hit && hit.t >= p.min_range && hit.t < best)
 				{
 					best = hit.t;

@@ -8,10 +8,16 @@
 // Floor that merely drops out (a ToF camera at grazing incidence, a shiny
 // patch) must not look like a hole, so a cell is judged against the dropout
 // rate of the floor measured in the same frame at the same range: with a
-// per-ray dropout rate q, floor leaves all n rays of a cell empty with
-// probability q^n; the cell is missing floor only when that chance is below
-// `alpha`. Missing cells are kept per connected region, and only regions that
-// border floor seen in the frame (an edge of valid floor around the gap).
+// per-ray dropout rate q, independent dropouts leave all n rays of a cell
+// empty with probability q^n. Real cameras drop out in blocks (a stereo or
+// structured-light matching window fails as a whole), so the frame also
+// measures how often a pixel next to an empty pixel is empty too, on floor it
+// did see (p11; = q for independent dropouts): a row of n empty rays then has
+// the chance q * max(q, p11)^(n-1). The cell is missing floor only when that
+// chance is below `alpha`. Missing cells are kept per connected region, and
+// only regions with floor seen in the frame next to them, along the rays,
+// both nearer to the sensor and farther away: a gap inside the floor, not the place where the
+// returns stop (a range cutoff) or start (the robot's own body).
 // Pure code: no MRPT, no I/O; no heap allocation per frame once sized.
 #pragma once
 
@@ -53,7 +59,9 @@ struct MissingFloorParams
 	template <class Self, class Visit>
 	static void forEachParam(Self& p, Visit&& visit)
 	{
-		visit(ParamInfo{"missing_floor", 0, 1, "mark floor that returned no depth where the ground predicts it"}, p.enabled);
+		visit(
+			ParamInfo{"missing_floor", 0, 1, "mark floor that returned no depth where the ground predicts it"},
+			p.enabled);
 		visit(
 			ParamInfo{"missing_floor_min_range", 0, 100, "no floor return is expected nearer than this depth [m]"},
 			p.min_range);
@@ -77,21 +85,23 @@ struct MissingFloorParams
 
 struct MissingFloorStats
 {
-	size_t rays = 0;          ///< pixels whose ray meets the ground within range
-	size_t empty_rays = 0;    ///< of those, no return (or one far below the floor)
-	size_t candidates = 0;    ///< cells with no sample, enough empty rays, unlikely as dropout
-	size_t cells = 0;         ///< missing-floor cells (in regions bordering floor)
-	size_t regions = 0;       ///< their connected regions
-	size_t unbordered = 0;    ///< candidate regions dropped: no seen floor next to them
-	size_t blocking = 0;      ///< missing cells within block_range
-	bool applied = false;     ///< the stage ran on this frame
+	size_t rays = 0;        ///< pixels whose ray meets the ground within range
+	size_t empty_rays = 0;  ///< of those, no return (or one far below the floor)
+	size_t candidates = 0;  ///< cells with no sample, enough empty rays, unlikely as dropout
+	size_t cells = 0;       ///< missing-floor cells (in regions bordering floor)
+	size_t regions = 0;     ///< their connected regions
+	size_t unbordered = 0;  ///< candidate regions dropped: no seen floor both before and beyond them
+	size_t blocking = 0;    ///< missing cells within block_range
+	bool applied = false;   ///< the stage ran on this frame
 };
 
 namespace missing
 {
 /** The chance that floor with per-ray dropout rate q leaves all n rays of a
- * cell empty (independent dropouts): q^n. */
-double emptyCellChance(double q, int n);
+ * cell empty, when a ray next to an empty one is empty with probability p11
+ * (a Markov chain along the rays): q * max(q, p11)^(n-1); q^n for
+ * independent dropouts (p11 = q). */
+double emptyCellChance(double q, double p11, int n);
 }  // namespace missing
 
 class MissingFloorDetector
@@ -113,9 +123,8 @@ class MissingFloorDetector
 	 * sensor returns floor (depth for depth images, range along the ray for
 	 * range images) [m]. */
 	void compute(
-		const SensorFrame& frame, const DepthProjector& projector, int decimation, double maxRange,
-		const Plane& ground, const ElevationGrid& grid, const std::vector<VoxelClass>& classes,
-		MissingFloorStats& stats);
+		const SensorFrame& frame, const DepthProjector& projector, int decimation, double maxRange, const Plane& ground,
+		const ElevationGrid& grid, const std::vector<VoxelClass>& classes, MissingFloorStats& stats);
 	/** Forgets the last frame's cells. */
 	void clear();
 
@@ -130,6 +139,9 @@ class MissingFloorDetector
 	 * met the ground in that range bin and returned nothing); 1 where no ray
 	 * met the ground there (no evidence). */
 	double dropoutRate(double depth) const;
+	/** How often the next pixel of a row is empty after an empty one, both
+	 * meeting the ground in cells where floor was seen (-1: no such pair). */
+	double neighbourDropoutRate() const { return m_p11; }
 
    private:
 	static constexpr uint8_t kCandidate = 1, kMissing = 2, kVisited = 4;
@@ -138,6 +150,7 @@ class MissingFloorDetector
 	std::vector<uint8_t> m_mark;    ///< per frame cell
 	std::vector<uint32_t> m_touched, m_cells, m_blocking, m_queue, m_region;
 	std::vector<uint32_t> m_binRays, m_binEmpty;
+	double m_p11 = -1;
 };
 
 }  // namespace gam

@@ -120,6 +120,16 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	/** The ISM evidence and voxel classes of the last 3D frame (frame grid). */
 	const gam::InverseSensorModel& lastFrameIsm() const { return m_pipeline.ism(); }
 
+	/** Missing floor (issue #13): where the ground plane predicted a floor
+	 * return within range and the camera returned nothing. A grid of the same
+	 * geometry as this one: occupied = missing floor (its last judgement),
+	 * free = floor seen since, unknown = never judged. Missing floor within
+	 * missing_floor_block_range of the sensor is also an obstacle in this grid;
+	 * a cell clears from the layer as soon as floor is seen there. */
+	const COccupancyGridMap2D& missingFloorLayer() const;
+	/** Whether a cell of the layer is missing floor now (world coordinates). */
+	bool isMissingFloor(float x, float y) const;
+
 	/** Splits each beam of a sparse scan (< 64 beams, e.g. a 16-segment Leddar)
 	 * into k rays, so the base beam model covers each segment's full width. */
 	static mrpt::obs::CObservation2DRangeScan upsampleSparseScan(
@@ -144,6 +154,8 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	bool insert2D(
 		const mrpt::obs::CObservation2DRangeScan& scan, const std::optional<const mrpt::poses::CPose3D>& robotPose);
 	void applyEvidence();
+	/** Gives the missing-floor layer this grid's geometry (cells kept). */
+	void syncMissingLayer() const;
 
 	TGroundAwareOptions m_options;
 	// The method and its per-frame workspace (not serialized).
@@ -151,6 +163,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	TFrameTimes m_times;
 	std::map<std::string, gam::MountMonitor> m_mounts;  // not serialized: state of a run
 	std::string m_lastSensorLabel;
+	mutable COccupancyGridMap2D m_missingLayer;
 };
 
 }  // namespace mrpt::maps

@@ -32,6 +32,23 @@ const char* categoryName(Category c);
 /** Parses "negative", "small", ... (returns false if unknown). */
 bool categoryFromName(const std::string& s, Category& c);
 
+/** How a surface answers a depth camera's or the Leddar's light (issue #13).
+ * Normal: the sensor models of Sensors.h. Absorbing: black or absorbing, no
+ * return at all. Transparent: clear glass or plastic, the light passes (the
+ * sensors see what is behind; the ground truth still has the object).
+ * Specular: a shiny floor patch, each pixel drops out with probability
+ * `dropout` (ObjectInfo), on top of the normal model. */
+enum class Material : int
+{
+	Normal = 0,
+	Absorbing,
+	Transparent,
+	Specular
+};
+const char* materialName(Material m);
+/** Parses "normal", "absorbing", "transparent", "specular". */
+bool materialFromName(const std::string& s, Material& m);
+
 /** A rigid pose: p_world = R * p_local + t. */
 struct Pose3
 {
@@ -53,6 +70,7 @@ struct ConvexSolid
 	std::vector<double> d;
 	Eigen::AlignedBox3d bbox;  ///< world-space bounds, for culling
 	int object_id = 0;
+	bool transparent = false;  ///< rays pass through it (Material::Transparent)
 
 	/** An oriented box: local frame centred on the box, half sizes h. */
 	static ConvexSolid box(const Pose3& centre, const Eigen::Vector3d& halfSize, int id);
@@ -108,8 +126,19 @@ struct ObjectInfo
 	Category category = Category::Large;
 	bool category_given = false;  ///< set explicitly in the scene file
 	bool traversable = false;     ///< ramps within the slope limit (set by GroundTruthGrid::build)
-	double slope_deg = 0;         ///< ramps: surface slope
+	Material material = Material::Normal;
+	double dropout = 0;    ///< Specular: per-pixel dropout probability
+	double slope_deg = 0;  ///< ramps: surface slope
 	Eigen::AlignedBox3d bbox;
+};
+
+/** A patch of floor with its own material (a black mat, a shiny tile):
+ * no geometry, the floor's hits inside it take the patch's object id. */
+struct FloorPatch
+{
+	double cx = 0, cy = 0, hx = 0, hy = 0, yaw = 0;
+	int object_id = 0;
+	bool containsXY(double x, double y) const;
 };
 
 /** Result of one ray cast. */
@@ -129,6 +158,7 @@ class Scene
 	std::vector<Hole> holes;
 	std::vector<ConvexSolid> solids;
 	std::vector<ObjectInfo> objects;
+	std::vector<FloorPatch> floor_patches;
 
 	/** Nearest surface along o + t*dir for t in (tmin, tmax]. `dir` need not be
 	 * unit: t is in units of |dir|. Exact for the floor, the pits and the
@@ -141,6 +171,8 @@ class Scene
 	bool insideMatter(const Eigen::Vector3d& p) const;
 
 	const ObjectInfo* object(int id) const;
+	/** The material of the surface of object `id` (0: plain floor). */
+	Material materialOf(int id) const;
 	/** Bounding box of all the solids and holes (the floor is unbounded). */
 	Eigen::AlignedBox3d bounds() const;
 
