@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# rawlog_tools/gam-detection-range smoke test (issue #13), ~20-40 s:
+# - single mode, two holes (10 x 5 cm and 30 x 5 cm), ranges 1.0 and 4.0 m,
+#   one seed: the table has its header and one row per object, with the
+#   geometric limits by hand: 0.10 * 0.8 / 0.03 = 2.67 m and
+#   0.30 * 0.8 / 0.03 = 8.0 m capped by the 4.5 m range; the summary CSV has
+#   one row per object and map and names the commit;
+# - approach mode, the 30 x 5 cm hole, one seed: a row whose ground_aware
+#   entry is a range within the 5.0 .. 1.0 m the approach covers;
+# - --help exits 0; a bad option, a missing build and --objects matching
+#   nothing exit 2 with one error line; --from re-reads detections.csv.
+# usage: test_gam_detection_range.sh BUILD_DIR REPO
+set -euo pipefail
+build="$1" repo="$2"
+tool="$repo/rawlog_tools/gam-detection-range"
+w="$(mktemp -d)"
+trap 'rm -rf "$w"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+"$tool" --build "$build" --modes single --objects '^hole_0\.(10|30)x0\.05$' --ranges "1.0 4.0" --seeds 1 \
+	--out "$w/single" --csv "$w/single.csv" --commit smoke >"$w/single.txt" 2>"$w/single.err" ||
+	{ cat "$w/single.err"; fail "single run failed"; }
+cat "$w/single.txt"
+grep -qxF "| object | geometric limit [m] | ground_aware [m] | ratio to the limit | height_band [m] | octomap [m] |" \
+	"$w/single.txt" || fail "single-frame table header"
+grep -Eq '^\| hole_0\.10x0\.05 \| 2\.67 \| (1\.00|4\.00|not detected)( \(gaps\))? \| [-0-9.]+ \| ' "$w/single.txt" ||
+	fail "hole_0.10x0.05 row (limit 2.67)"
+grep -Eq '^\| hole_0\.30x0\.05 \| 4\.50 \| (1\.00|4\.00|not detected)( \(gaps\))? \| [-0-9.]+ \| ' "$w/single.txt" ||
+	fail "hole_0.30x0.05 row (limit 8.0 m capped at 4.50)"
+[[ "$(grep -c '^| hole_' "$w/single.txt")" -eq 2 ]] || fail "two rows expected"
+grep -qx "# commit: smoke" "$w/single.csv" || fail "CSV names the commit"
+[[ "$(grep -c '^hole_0\.[13]0x0\.05,hole,.*,single,' "$w/single.csv")" -eq 6 ]] || fail "CSV: 2 objects x 3 maps"
+grep -q '^hole_0.30x0.05,hole,0.3,0.05,4.5,single,ground_aware,1,' "$w/single.csv" || fail "CSV limit column"
+[[ -s "$w/single/detections.csv" && -s "$w/single/tables.md" ]] || fail "--out files"
+
+"$tool" --build "$build" --modes approach --objects '^hole_0\.30x0\.05$' --seeds 1 --out "$w/appr" \
+	>"$w/appr.txt" 2>"$w/appr.err" || { cat "$w/appr.err"; fail "approach run failed"; }
+cat "$w/appr.txt"
+row="$(grep '^| hole_0.30x0.05 | 4.50 |' "$w/appr.txt")" || fail "approach row"
+ga="$(cut -d'|' -f4 <<<"$row" | xargs)"
+awk -v v="$ga" 'BEGIN { exit !(v + 0 >= 1.0 && v + 0 <= 5.0) }' || fail "approach ground_aware '$ga' not in 1..5 m"
+[[ "$(awk -F, '$2 == "approach" && $6 == "ground_aware"' "$w/appr/detections.csv" | wc -l)" -eq 81 ]] ||
+	fail "approach: 81 frames per map"
+[[ ! -e "$w/appr/approach/hole_0.30x0.05/s1/maps/snapshots" ]] || fail "snapshots not removed"
+
+"$tool" --from "$w/single/detections.csv" --commit smoke >"$w/from.txt" || fail "--from"
+cmp -s <(grep '^| hole_' "$w/single.txt") <(grep '^| hole_' "$w/from.txt") || fail "--from gives other tables"
+
+"$tool" --help | grep -q "usage: rawlog_tools/gam-detection-range" || fail "--help"
+set +e
+"$tool" --bogus 2>"$w/err"
+[[ $? -eq 2 && "$(wc -l <"$w/err")" -eq 1 ]] || fail "unknown option: exit 2, one line"
+"$tool" --build "$w/nowhere" 2>"$w/err"
+[[ $? -eq 2 ]] && grep -q "not built" "$w/err" || fail "missing build not reported"
+"$tool" --build "$build" --objects 'no_such_object' 2>"$w/err"
+[[ $? -eq 2 ]] && grep -q "matches no object" "$w/err" || fail "--objects matching nothing"
+"$tool" --seeds 0 2>"$w/err"
+[[ $? -eq 2 ]] || fail "--seeds 0 accepted"
+echo "PASS"
