@@ -10,6 +10,7 @@ PKGS=(
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth
   clang libclang-rt-14-dev clang-format
+  python3-rosbag python3-sensor-msgs python3-nav-msgs python3-tf2-msgs python3-geometry-msgs
   python3-matplotlib  # only for the plot of rawlog_tools/gam-detection-range (doc/figures/detection-range.png)
 )
 SUDO=""
