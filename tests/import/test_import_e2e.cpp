@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "Import.h"
+
 namespace fs = std::filesystem;
 using mrpt::obs::CObservation3DRangeScan;
 using mrpt::obs::CObservationOdometry;
@@ -401,6 +403,91 @@ TEST_P(GamImportRealPcd, SameRangeImageAndSameMapsAsTheStoredRawlog)
 INSTANTIATE_TEST_SUITE_P(
 	RealKinect, GamImportRealPcd,
 	::testing::Values("pcl_milk_bottles_on_carpet", "pcl_office1", "pcl_five_people_corridor"));
+
+namespace
+{
+size_t differingCells(const std::string& a, const std::string& b, size_t* total)
+{
+	int w1 = 0, h1 = 0, w2 = 0, h2 = 0;
+	const auto ca = pgmCells(a, w1, h1), cb = pgmCells(b, w2, h2);
+	if (ca.empty() || w1 != w2 || h1 != h2) return size_t(-1);
+	size_t n = 0;
+	for (size_t i = 0; i < ca.size(); i++) n += ca[i] != cb[i];
+	*total = ca.size();
+	return n;
+}
+}  // namespace
+
+// Real depth through the PNG and TUM paths: the stored milk-bottles frame written
+// as a 16-bit PNG (mm), imported with the stored intrinsics (png) and as a TUM
+// sequence whose ground truth puts the robot at the origin (tum: the camera's
+// optical pose = sensorPose (+) sensor<-optical), gives the stored rawlog's maps.
+TEST(GamImportRealDepthPng, MilkFrameAsPngAndAsTumSequenceGiveTheStoredMaps)
+{
+	const std::string stored = realData("pcl_milk_bottles_on_carpet/pcl_milk_bottles_on_carpet.rawlog");
+	if (!fs::exists(stored)) GTEST_SKIP() << "no " << stored;
+	const auto ref = firstScan(stored);
+	ASSERT_TRUE(ref);
+	ASSERT_FLOAT_EQ(ref->rangeUnits, 0.001f);
+	const std::string d = tmpDir("real_png");
+	fs::create_directories(d + "/png");
+	fs::create_directories(d + "/tum/depth");
+	mrpt::img::CImage im;
+	const int W = int(ref->rangeImage.cols()), H = int(ref->rangeImage.rows());
+	im.resize(W, H, mrpt::img::CH_GRAY, mrpt::img::PixelDepth::D16U);
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++) im.ptr<uint16_t>(0, r)[c] = ref->rangeImage(r, c);
+	ASSERT_TRUE(im.saveToFile(d + "/png/frame.png"));
+	ASSERT_TRUE(im.saveToFile(d + "/tum/depth/1.000000.png"));
+	const auto& cp = ref->cameraParams;
+	char k[300];
+	std::snprintf(k, sizeof k, "'%d %d %.17g %.17g %.17g %.17g'", W, H, cp.fx(), cp.fy(), cp.cx(), cp.cy());
+	const std::string common = std::string(" --intrinsics ") + k + " --sensor-pose " + poseArg(ref->sensorPose);
+	ProcessResult r = import("png -i " + d + "/png -o " + d + "/png.rawlog" + common);
+	ASSERT_EQ(r.rc, 0) << r.err;
+
+	writeText(d + "/tum/depth.txt", "# timestamp filename\n1.000000 depth/1.000000.png\n");
+	const auto optical = ref->sensorPose + gam::import::opticalInSensorFrame();
+	mrpt::math::CQuaternionDouble q;
+	optical.getAsQuaternion(q);
+	std::string gt = "# timestamp tx ty tz qx qy qz qw\n";
+	for (const char* t : {"0.99", "1.01"})
+	{
+		char line[400];
+		std::snprintf(
+			line, sizeof line, "%s %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", t, optical.x(), optical.y(),
+			optical.z(), q.x(), q.y(), q.z(), q.r());
+		gt += line;
+	}
+	writeText(d + "/tum/groundtruth.txt", gt);
+	r = import("tum -i " + d + "/tum -o " + d + "/tum.rawlog --depth-scale 1000" + common);
+	ASSERT_EQ(r.rc, 0) << r.err;
+	const auto e = readRawlog(d + "/tum.rawlog");
+	ASSERT_EQ(e.size(), 2u);
+	ASSERT_TRUE(e[0].odo);
+	EXPECT_NEAR(e[0].odo->odometry.x(), 0, 1e-9);
+	EXPECT_NEAR(e[0].odo->odometry.y(), 0, 1e-9);
+	EXPECT_NEAR(e[0].odo->odometry.phi(), 0, 1e-9);
+
+#ifdef GAM_MAPPER_EXE
+	const std::string mapper = GAM_MAPPER_EXE;
+	ASSERT_EQ(run(mapper + " -q -r " + stored + " -o " + d + "/maps_stored").rc, 0);
+	ASSERT_EQ(run(mapper + " -q -r " + d + "/png.rawlog -o " + d + "/maps_png").rc, 0);
+	ASSERT_EQ(run(mapper + " -q -r " + d + "/tum.rawlog -o " + d + "/maps_tum").rc, 0);
+	for (const char* grid : {"ground_aware", "height_band", "octomap"})
+	{
+		SCOPED_TRACE(grid);
+		const std::string f = std::string("/") + grid + ".pgm";
+		size_t total = 0;
+		const size_t dPng = differingCells(d + "/maps_stored" + f, d + "/maps_png" + f, &total);
+		const size_t dTum = differingCells(d + "/maps_stored" + f, d + "/maps_tum" + f, &total);
+		EXPECT_EQ(dPng, 0u);
+		EXPECT_EQ(dTum, 0u);
+		std::cout << "milk " << grid << " of " << total << " cells: png differs in " << dPng << ", tum in " << dTum
+				  << "\n";
+	}
+#endif
+}
 
 TEST(GamImportPcd, KinectV2IntrinsicsAndBadFiles)
 {
