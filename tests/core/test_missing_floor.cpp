@@ -123,10 +123,11 @@ TEST(MissingFloor, DarkHoleInSeenFloorIsMarked)
 	// Every one of the 1600 rays meets the floor at depth 1 m; 64 are empty.
 	EXPECT_EQ(res.stats.rays, 1600u);
 	EXPECT_EQ(res.stats.empty_rays, 64u);
-	EXPECT_NEAR(res.det.dropoutRate(1.0), 64.0 / 1600.0, 1e-12);  // q = 0.04
-	// No empty ray lies on seen floor: no neighbour statistics (independent).
+	// No empty ray lies on seen floor: the floor's dropout rate is 0, and
+	// there are no neighbour statistics (independent).
+	EXPECT_EQ(res.det.dropoutRate(1.0), 0.0);
 	EXPECT_EQ(res.det.neighbourDropoutRate(), -1);
-	// Each hole cell: 16 empty rays, 0.04^16 = 4e-23 << alpha = 1e-3.
+	// Each hole cell: 16 empty rays, 0^16 = 0 <= alpha = 1e-3.
 	for (int ix : {9, 10})
 		for (int iy : {7, 8})
 		{
@@ -178,9 +179,12 @@ TEST(MissingFloor, FloorThatDropsOutOftenIsNotAHole)
 	// Valid pixels: i % 10 == 0 gives 160, minus those in rows 0-3, cols 0-3
 	// (i = 0, 40, 80, 120: 4 of them) = 156; empty = 1600 - 156 = 1444.
 	EXPECT_EQ(res.stats.empty_rays, 1444u);
-	const double q = 1444.0 / 1600.0;  // 0.9025
+	// Seen cells: y cells 12 (cols 8-11), 9 (cols 20-23), 7 (cols 28-31) in
+	// all 40 rows and 14 (cols 0-3) in rows 4-39: 3 * 40 * 4 + 36 * 4 = 624
+	// rays, one valid in 4 (156): q = 468 / 624 = 0.75.
+	const double q = 0.75;
 	EXPECT_NEAR(res.det.dropoutRate(1.0), q, 1e-12);
-	// 0.9025^16 = 0.194: such floor often leaves a cell empty -> not missing.
+	// 0.75^16 = 0.010 (more with p11 > q): such floor leaves cells empty.
 	EXPECT_GT(missing::emptyCellChance(q, -1, 16), 1e-3);
 	EXPECT_EQ(res.det.emptyRays(cellOf(14, 14)), 16);
 	EXPECT_FALSE(res.det.isMissing(cellOf(14, 14)));
@@ -198,9 +202,11 @@ TEST(MissingFloor, BlockyDropoutsOnSeenFloorAreNotAHole)
 	// 14 (col 0 returns) and 11 (col 15 returns) are seen floor with empty
 	// rays. Pairs of neighbours on seen floor, per row: (1,2), (2,3), (12,13),
 	// (13,14) both empty, (14,15) empty then valid ((3,4) and (11,12) touch an
-	// unseen cell): p11 = 4 / 5 = 0.8. q = 8 * 14 / 1600 = 0.07. A fully
-	// empty cell: 0.07 * 0.8^15 = 0.07 * 0.035184 = 0.0024629 > alpha = 1e-3:
-	// blocky dropouts, not a hole.
+	// unseen cell): p11 = 4 / 5 = 0.8. Every cell but the 4 empty ones is
+	// seen: 1600 - 4 * 16 = 1536 rays, 112 - 64 = 48 of them empty:
+	// q = 48 / 1536 = 0.03125. A fully empty cell: 0.03125 * 0.8^15 =
+	// 0.03125 * 0.0351844 = 0.0010995 > alpha = 1e-3: blocky dropouts, not a
+	// hole (with independent dropouts it would be: 0.03125^16 = 8.7e-25).
 	Scene s;
 	for (int r = 8; r < 16; r++)
 		for (int c = 1; c < 15; c++) s.at(r, c) = 0;
@@ -208,7 +214,8 @@ TEST(MissingFloor, BlockyDropoutsOnSeenFloorAreNotAHole)
 	run(s, res);
 	EXPECT_EQ(res.stats.empty_rays, 112u);
 	EXPECT_DOUBLE_EQ(res.det.neighbourDropoutRate(), 0.8);
-	EXPECT_NEAR(missing::emptyCellChance(0.07, 0.8, 16), 0.0024629, 1e-6);
+	EXPECT_NEAR(res.det.dropoutRate(1.0), 0.03125, 1e-12);
+	EXPECT_NEAR(missing::emptyCellChance(0.03125, 0.8, 16), 0.0010995, 1e-7);
 	for (int ix : {11, 12})
 		for (int iy : {12, 13})
 		{
@@ -217,8 +224,7 @@ TEST(MissingFloor, BlockyDropoutsOnSeenFloorAreNotAHole)
 		}
 	EXPECT_EQ(res.stats.cells, 0u);
 	// The same empty block with independent dropouts would be a hole:
-	// 0.07^16 = 3.3e-19.
-	EXPECT_LT(missing::emptyCellChance(0.07, -1, 16), 1e-3);
+	EXPECT_LT(missing::emptyCellChance(0.03125, -1, 16), 1e-3);
 }
 
 TEST(MissingFloor, ReturnsFarBelowTheFloorCountAsNoFloor)
@@ -243,7 +249,7 @@ TEST(MissingFloor, WhereTheReturnsStopIsNotAHole)
 	// Rows 0-7 return nothing: x cells 13 and 14, the far edge of the view
 	// (as a range cutoff, or an image border the camera does not fill). Floor
 	// is seen nearer (x cell 12) but nothing beyond: not a gap in the floor.
-	// (q = 320 / 1600 = 0.2 and 0.2^16 = 6.6e-12 would pass the cell test.)
+	// (The seen floor drops nothing, q = 0: its cells pass the cell test.)
 	Scene s;
 	for (int r = 0; r < 8; r++)
 		for (int c = 0; c < kSize; c++) s.at(r, c) = 0;

@@ -112,12 +112,16 @@ void MissingFloorDetector::compute(
 			const uint16_t v = img.at(r, c);
 			const double got = double(v) * units;
 			const bool empty = v == 0 || (got > maxRange && got > expected + m_params.beyond_margin);
-			const size_t bin = size_t(expected / m_params.range_bin);
-			m_binRays[bin]++;
 			stats.rays++;
+			if (empty) stats.empty_rays++;
 			const uint32_t cell = uint32_t(g.index(cx, cy));
 			if (grid.cell(cell).count > 0)
 			{
+				// Seen floor (or whatever was seen there): its dropouts are the
+				// camera's, not a hole's.
+				const size_t bin = size_t(expected / m_params.range_bin);
+				m_binRays[bin]++;
+				if (empty) m_binEmpty[bin]++;
 				prev = empty ? 2 : 1;
 				if (before == 2)
 				{
@@ -126,8 +130,6 @@ void MissingFloorDetector::compute(
 				}
 			}
 			if (!empty) continue;
-			m_binEmpty[bin]++;
-			stats.empty_rays++;
 			if (m_empty[cell] == 0) m_touched.push_back(cell);
 			if (m_empty[cell] < 65535) m_empty[cell]++;
 		}
@@ -174,18 +176,28 @@ void MissingFloorDetector::compute(
 			const uint32_t c = m_queue[qi];
 			m_region.push_back(c);
 			const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
-			// The cells one step nearer and one step farther along the ray
-			// from the sensor through this cell.
+			// The first cell nearer and the first one farther along the ray
+			// from the sensor through this cell that a ray reached (far away
+			// the pixel rows are sparser than the cells: skip up to 3 cells
+			// no ray met).
 			const double ux = g.cx(cx) - s.x(), uy = g.cy(cy) - s.y();
 			const double len = std::sqrt(ux * ux + uy * uy);
 			if (len > 0)
 				for (int side : {-1, 1})
-				{
-					const double k = side * g.resolution / len;
-					const int ax = g.ix(g.cx(cx) + k * ux), ay = g.iy(g.cy(cy) + k * uy);
-					if (!g.inside(ax, ay) || classes[g.index(ax, ay)] != VoxelClass::Ground) continue;
-					(side < 0 ? nearer : farther) = true;
-				}
+					for (int step = 1; step <= 4; step++)
+					{
+						const double k = side * step * g.resolution / len;
+						const int ax = g.ix(g.cx(cx) + k * ux), ay = g.iy(g.cy(cy) + k * uy);
+						if (!g.inside(ax, ay)) break;
+						const size_t a = g.index(ax, ay);
+						if (a == c) continue;
+						if (classes[a] == VoxelClass::Ground)
+						{
+							(side < 0 ? nearer : farther) = true;
+							break;
+						}
+						if (grid.cell(a).count > 0 || m_empty[a] > 0) break;  // seen, or a ray came back empty
+					}
 			for (int dy = -1; dy <= 1; dy++)
 				for (int dx = -1; dx <= 1; dx++)
 				{

@@ -7,7 +7,8 @@
 //
 // Floor that merely drops out (a ToF camera at grazing incidence, a shiny
 // patch) must not look like a hole, so a cell is judged against the dropout
-// rate of the floor measured in the same frame at the same range: with a
+// rate of the floor seen in the same frame at the same range (rays in cells
+// that got samples): with a
 // per-ray dropout rate q, independent dropouts leave all n rays of a cell
 // empty with probability q^n. Real cameras drop out in blocks (a stereo or
 // structured-light matching window fails as a whole), so the frame also
@@ -135,9 +136,10 @@ class MissingFloorDetector
 	bool isMissing(uint32_t cell) const { return cell < m_mark.size() && m_mark[cell] == kMissing; }
 	/** Empty rays per frame cell in the last frame (0 where none). */
 	uint16_t emptyRays(uint32_t cell) const { return cell < m_empty.size() ? m_empty[cell] : 0; }
-	/** The dropout rate measured in the last frame at depth `depth` (rays that
-	 * met the ground in that range bin and returned nothing); 1 where no ray
-	 * met the ground there (no evidence). */
+	/** The dropout rate of seen floor measured in the last frame at depth
+	 * `depth`: of the rays that met the ground in that range bin, in cells
+	 * that have samples, the share that returned nothing (a hole's own rays do
+	 * not inflate it); 1 where there was no such ray (no evidence). */
 	double dropoutRate(double depth) const;
 	/** How often the next pixel of a row is empty after an empty one, both
 	 * meeting the ground in cells where floor was seen (-1: no such pair). */
