@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include "gam/eval/Evaluation.h"
 
@@ -47,8 +48,21 @@ std::vector<std::pair<double, double>> loadPath(const std::string& prefix)
 	return path;
 }
 
+/** The missing-floor layer written next to a ground-aware map
+ * (DIR/<label>_missing_floor.yaml beside DIR/<label>.yaml), if there is one. */
+std::optional<RosMap> missingFloorOf(const RosMap& map)
+{
+	namespace fs = std::filesystem;
+	const fs::path y(map.yamlPath);
+	const fs::path layer = y.parent_path() / (y.stem().string() + "_missing_floor.yaml");
+	std::error_code ec;
+	if (!fs::exists(layer, ec)) return std::nullopt;
+	return loadRosMap(layer.string());
+}
+
 /** GT panel + one panel per map, all on the GT grid (+y up), cells scaled up;
- * the robot's path on every panel, a 1 m scale bar and a legend. */
+ * the robot's path on every panel, a 1 m scale bar and a legend. A map with a
+ * missing-floor layer beside it shows its missing-floor cells in orange. */
 void writePng(
 	const std::string& path, const std::string& title, const GroundTruth& gt, const std::vector<RosMap>& maps,
 	const std::vector<MapScore>& scores)
@@ -100,11 +114,19 @@ void writePng(
 			default: return unknown;
 		}
 	});
+	const TColor missingColour(255, 140, 0);
 	for (size_t m = 0; m < maps.size(); m++)
 	{
 		const Resampled r = resample(gt, maps[m]);
 		const auto st = classify(r, scores[m].main.occ, scores[m].main.free);
+		std::vector<bool> missing(st.size(), false);
+		if (const auto layer = missingFloorOf(maps[m]))
+		{
+			const Resampled rl = resample(gt, *layer);
+			for (size_t i = 0; i < missing.size(); i++) missing[i] = rl.pMax[i] > 0.5;
+		}
 		panel(int(m) + 1, scores[m].name, [&](size_t i) {
+			if (missing[i]) return missingColour;
 			if (st[i] == CellState::Unknown) return unknown;
 			const double p = st[i] == CellState::Occupied ? r.pMax[i] : r.pMin[i];
 			const auto g = uint8_t(std::clamp(std::lround(255.0 * (1.0 - p)), 0L, 255L));
@@ -125,6 +147,7 @@ void writePng(
 		swatch(TColor(255, 255, 255), "free");
 		swatch(TColor(0, 0, 0), "occupied");
 		swatch(unknown, "unknown");
+		swatch(missingColour, "missing floor");
 		swatch(TColor(200, 30, 30), "GT drop / hole");
 		im.line(x, y + 6, x + 14, y + 6, TColor(220, 0, 0), 2);
 		im.textOut(x + 18, y + 2, "robot path", TColor(0, 0, 0));
