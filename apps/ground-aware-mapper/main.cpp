@@ -62,6 +62,10 @@ int main(int argc, char** argv)
 			"after every N-th frame, write the map_server maps (<label>.yaml/.pgm) of every 2D grid into "
 			"DIR/snapshots/NNNNNN/ (NNNNNN = frames so far; index in DIR/snapshots/index.csv); 0 = none",
 			false, 0, "N", cmd);
+		TCLAP::SwitchArg aPngLegend(
+			"", "png-legend",
+			"PNGs with a 1 m scale bar and a legend (free, occupied, unknown, missing floor; missing floor in orange)",
+			cmd);
 		TCLAP::SwitchArg aQuiet("q", "quiet", "no progress line on stderr", cmd);
 		if (const int rc = gam::parseCommandLine(cmd, argc, argv, "ground-aware-mapper"); rc >= 0) return rc;
 
@@ -82,6 +86,7 @@ int main(int argc, char** argv)
 		o.localCells = aLocalCells.getValue();
 		o.maxFrames = size_t(aMaxFrames.getValue());
 		o.snapshotEvery = size_t(aSnapshotEvery.getValue());
+		o.pngLegend = aPngLegend.getValue();
 		o.progress = !aQuiet.getValue();
 		if (aConfig.getValue().empty())
 		{

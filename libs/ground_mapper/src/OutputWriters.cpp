@@ -28,6 +28,7 @@ void Mapper::writeMaps(const std::string& dir, RunSummary& s)
 			ctx.robotX = m_lastPose.x();
 			ctx.robotY = m_lastPose.y();
 			ctx.localCells = m_opts.localCells;
+			ctx.pngLegend = m_opts.pngLegend;
 			t->writeOutputs(map, ctx, s.files);
 		}
 		else

@@ -38,7 +38,15 @@ const bool kTraitsRegistered = [] {
 		COccupancyGridMap2D layer = g.missingFloorLayer();
 		const std::string stem = ctx.label + "_missing_floor", base = ctx.dir + "/" + stem;
 		gam::maps::writeRosMap(layer, base + ".yaml", base + ".pgm", stem + ".pgm");
-		gam::maps::writeGridPng(layer, base + ".png");
+		gam::maps::PngStyle style;
+		style.legend = ctx.pngLegend;
+		gam::maps::writeGridPng(layer, base + ".png", style);
+		if (ctx.pngLegend)
+		{
+			// The map's picture again, with its missing floor in orange.
+			style.missing = &layer;
+			gam::maps::writeGridPng(g, ctx.dir + "/" + ctx.label + ".png", style);
+		}
 		for (const char* ext : {".yaml", ".pgm", ".png"}) files.push_back(stem + ext);
 	};
 	t.keepWindow = [](CMetricMap& m, double x, double y, int cells) {

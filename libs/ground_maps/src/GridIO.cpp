@@ -95,19 +95,28 @@ PngView pngViewOf(const COccupancyGridMap2D& g)
 	return v;
 }
 
-void writeGridPng(const COccupancyGridMap2D& g, const std::string& path)
+void writeGridPng(const COccupancyGridMap2D& g, const std::string& path, const PngStyle& style)
 {
 	const PngView v = pngViewOf(g);
 	const int k = v.scale;
-	mrpt::img::CImage im(v.w * k, v.h * k, mrpt::img::CH_RGB);
+	const int strip = style.legend ? 40 : 0;  // scale bar + legend below the map
+	const int W = std::max(v.w * k, style.legend ? 430 : 1);
+	mrpt::img::CImage im(W, v.h * k + strip, mrpt::img::CH_RGB);
+	im.filledRectangle(0, 0, W - 1, v.h * k + strip - 1, mrpt::img::TColor(255, 255, 255));
+	const COccupancyGridMap2D* L = style.missing;
+	const bool layerFits = L && L->getSizeX() == g.getSizeX() && L->getSizeY() == g.getSizeY();
 	for (int r = 0; r < v.h; r++)
 	{
-		const auto* src = g.getRow(v.cy0 + v.h - 1 - r);
+		const int cy = v.cy0 + v.h - 1 - r;
+		const auto* src = g.getRow(cy);
+		const auto* lay = layerFits ? L->getRow(cy) : nullptr;
 		for (int x = 0; x < v.w; x++)
 		{
 			const auto cell = src[v.cx0 + x];
 			mrpt::img::TColor c(kUnknownR, kUnknownG, kUnknownB);
-			if (cell != 0)
+			if (lay && COccupancyGridMap2D::l2p(lay[v.cx0 + x]) < 0.5f)
+				c = mrpt::img::TColor(kMissingR, kMissingG, kMissingB);
+			else if (cell != 0)
 			{
 				const uint8_t p = pgmValue(cell);
 				c = mrpt::img::TColor(p, p, p);
@@ -115,6 +124,27 @@ void writeGridPng(const COccupancyGridMap2D& g, const std::string& path)
 			for (int dy = 0; dy < k; dy++)
 				for (int dx = 0; dx < k; dx++) im.setPixel(x * k + dx, r * k + dy, c);
 		}
+	}
+	if (style.legend)
+	{
+		using mrpt::img::TColor;
+		const int y0 = v.h * k;
+		// 1 m scale bar.
+		const int bar = int(std::lround(1.0 / g.getResolution() * k));
+		im.filledRectangle(6, y0 + 4, 6 + bar, y0 + 7, TColor(0, 90, 200));
+		im.textOut(10 + bar, y0 + 1, "1 m", TColor(0, 90, 200));
+		int x = 6;
+		const int y = y0 + 22;
+		const auto swatch = [&](const TColor& c, const std::string& text) {
+			im.filledRectangle(x, y, x + 12, y + 12, c);
+			im.rectangle(x, y, x + 12, y + 12, TColor(120, 120, 120));
+			im.textOut(x + 16, y + 2, text, TColor(0, 0, 0));
+			x += 16 + 9 * int(text.size()) + 14;
+		};
+		swatch(TColor(255, 255, 255), "free");
+		swatch(TColor(0, 0, 0), "occupied");
+		swatch(TColor(kUnknownR, kUnknownG, kUnknownB), "unknown");
+		if (L) swatch(TColor(kMissingR, kMissingG, kMissingB), "missing floor");
 	}
 	if (!im.saveToFile(path)) throw std::runtime_error("cannot write " + path);
 }

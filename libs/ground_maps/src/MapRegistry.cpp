@@ -80,7 +80,9 @@ void writeGridOutputs(mrpt::maps::CMetricMap& map, const OutputContext& ctx, std
 	const std::string base = ctx.dir + "/" + ctx.label;
 	writeRosMap(g, base + ".yaml", base + ".pgm", ctx.label + ".pgm");
 	writePlainGridmapGz(g, base + ".gridmap.gz");
-	writeGridPng(g, base + ".png");
+	PngStyle style;
+	style.legend = ctx.pngLegend;
+	writeGridPng(g, base + ".png", style);
 	for (const char* ext : {".yaml", ".pgm", ".gridmap.gz", ".png"}) files.push_back(ctx.label + ext);
 }
 

@@ -42,6 +42,10 @@ struct MapperOptions
 	 * `outDir/snapshots/NNNNNN/` (NNNNNN = frames inserted so far), plus
 	 * `outDir/snapshots/index.csv`. Published with the other outputs. */
 	size_t snapshotEvery = 0;
+	/** The PNGs of the 2D grids get a 1 m scale bar and a legend (free,
+	 * occupied, unknown, missing floor); ground-aware grids show their
+	 * missing floor in orange. The map_server files are unchanged. */
+	bool pngLegend = false;
 	bool progress = true;
 	/** If set, checked before every frame: non-zero stops the run (RunError
 	 * "interrupted"; nothing is published in outDir). For SIGINT/SIGTERM handlers. */

@@ -40,10 +40,22 @@ struct PngView
  * factor (<= 8) towards ~600 px. */
 PngView pngViewOf(const mrpt::maps::COccupancyGridMap2D& grid);
 
+/** How writeGridPng() draws. */
+struct PngStyle
+{
+	/** A 1 m scale bar and a legend (free, occupied, unknown, and missing
+	 * floor when `missing` is set) in a strip below the map. */
+	bool legend = false;
+	/** A missing-floor layer of the same geometry (CGroundAwareOccupancyGrid::
+	 * missingFloorLayer()): its missing cells are drawn orange. */
+	const mrpt::maps::COccupancyGridMap2D* missing = nullptr;
+};
+
 /** RGB picture of pngViewOf(grid): grey = the PGM value of the cell; cells never
  * observed (log-odds exactly 0) are light blue (kUnknown*). */
-void writeGridPng(const mrpt::maps::COccupancyGridMap2D& grid, const std::string& path);
+void writeGridPng(const mrpt::maps::COccupancyGridMap2D& grid, const std::string& path, const PngStyle& style = {});
 constexpr uint8_t kUnknownR = 190, kUnknownG = 205, kUnknownB = 235;
+constexpr uint8_t kMissingR = 255, kMissingG = 140, kMissingB = 0;
 
 /** A plain copy (slices a derived grid). */
 mrpt::maps::COccupancyGridMap2D plainCopy(const mrpt::maps::COccupancyGridMap2D& grid);

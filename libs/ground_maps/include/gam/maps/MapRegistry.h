@@ -33,6 +33,7 @@ struct OutputContext
 	bool localMap = false;          ///< robot-centred window mode
 	double robotX = 0, robotY = 0;  ///< last robot position (map frame)
 	int localCells = 600;           ///< window size [cells]
+	bool pngLegend = false;         ///< PNGs with a 1 m scale bar and a legend
 };
 
 /** Ground plane of the last depth frame, for ground_planes.csv. */
