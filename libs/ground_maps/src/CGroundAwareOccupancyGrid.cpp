@@ -250,6 +250,7 @@ bool CGroundAwareOccupancyGrid::insert2D(
 	// shallower than the ground band -- to the log-odds clamp, and the drop
 	// seen later from close by could no longer mark them: issue #17.)
 	const std::vector<cellType> before = m_map;
+	const double scanTime = rawScan.timestamp == INVALID_TIMESTAMP ? 0.0 : mrpt::Clock::toDouble(rawScan.timestamp);
 	const float x0 = getXMin(), y0 = getYMin();
 	const int sx0 = int(getSizeX()), sy0 = int(getSizeY());
 	const bool changed = COccupancyGridMap2D::internal_insertObservation(use, robotPose);
@@ -265,7 +266,9 @@ bool CGroundAwareOccupancyGrid::insert2D(
 			if (nx < 0 || ny < 0 || nx >= sx || ny >= sy) continue;
 			cellType& now = m_map[size_t(ny) * size_t(sx) + size_t(nx)];
 			if (now > old) now = old;
+			if (m_options.obstacle_decay_s > 0 && now < old) notePositive(nx, ny, scanTime);
 		}
+	if (m_options.obstacle_decay_s > 0 && scanTime > 0) decayObstacles(scanTime);
 	return changed;
 }
 
@@ -318,6 +321,28 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 	}
 	const auto t1 = clk::now();
 	applyEvidence();
+	if (m_options.obstacle_decay_s > 0 && obs.timestamp != INVALID_TIMESTAMP)
+	{
+		// Positive obstacles of this frame are fresh; cells that were judged a
+		// hole, a drop or missing floor never decay.
+		const double t = mrpt::Clock::toDouble(obs.timestamp);
+		const auto& g = m_pipeline.frameGrid().geometry();
+		const auto& cls = m_pipeline.ism().classes();
+		const auto& ev = m_pipeline.ism().evidence();
+		const auto& missing = m_pipeline.missingFloor();
+		for (uint32_t c : m_pipeline.ism().evidenceCells())
+		{
+			const int wx = x2idx(g.cx(int(c % uint32_t(g.nx)))), wy = y2idx(g.cy(int(c / uint32_t(g.nx))));
+			if (ev[c] <= 0.5f) continue;
+			if (c < cls.size() && cls[c] == gam::VoxelClass::Obstacle && !missing.isMissing(c))
+				notePositive(wx, wy, t);
+			else
+				noteNegative(wx, wy);
+		}
+		for (uint32_t c : missing.cells())
+			noteNegative(x2idx(g.cx(int(c % uint32_t(g.nx)))), y2idx(g.cy(int(c / uint32_t(g.nx)))));
+		decayObstacles(t);
+	}
 	const auto t2 = clk::now();
 
 	m_times.update = std::chrono::duration<double, std::milli>(t2 - t1).count();
@@ -345,6 +370,51 @@ void CGroundAwareOccupancyGrid::syncMissingLayer() const
 				fresh.getRow(ny)[nx] = L.getRow(int(cy))[cx];
 			}
 	L = std::move(fresh);
+}
+
+namespace
+{
+// A world cell index, independent of the grid's extent: floor(x / res).
+int64_t worldKey(int64_t ix, int64_t iy) { return (ix << 32) ^ (iy & 0xffffffffLL); }
+}  // namespace
+
+void CGroundAwareOccupancyGrid::notePositive(int cx, int cy, double t)
+{
+	const double r = getResolution();
+	const int64_t ix = std::llround(std::floor(idx2x(unsigned(cx)) / r)),
+				  iy = std::llround(std::floor(idx2y(unsigned(cy)) / r));
+	m_positiveSeen[worldKey(ix, iy)] = t;
+}
+
+void CGroundAwareOccupancyGrid::noteNegative(int cx, int cy)
+{
+	const double r = getResolution();
+	const int64_t ix = std::llround(std::floor(idx2x(unsigned(cx)) / r)),
+				  iy = std::llround(std::floor(idx2y(unsigned(cy)) / r));
+	m_positiveSeen.erase(worldKey(ix, iy));
+}
+
+void CGroundAwareOccupancyGrid::decayObstacles(double t)
+{
+	const double r = getResolution();
+	for (auto it = m_positiveSeen.begin(); it != m_positiveSeen.end();)
+	{
+		if (t - it->second <= m_options.obstacle_decay_s)
+		{
+			++it;
+			continue;
+		}
+		const int64_t ix = it->first >> 32, iy = int64_t(int32_t(it->first & 0xffffffffLL));
+		const int cx = x2idx((ix + 0.5) * r), cy = y2idx((iy + 0.5) * r);
+		// Only an obstacle returns to unknown; a cell seen free since stays free.
+		if (cx >= 0 && cy >= 0 && cx < int(getSizeX()) && cy < int(getSizeY()))
+		{
+			cellType& cell = m_map[size_t(cx) + size_t(cy) * getSizeX()];
+			if (cell < 0) cell = 0;
+		}
+		it = m_positiveSeen.erase(it);
+	}
+	m_likelihoodCacheOutDated = true;
 }
 
 const COccupancyGridMap2D& CGroundAwareOccupancyGrid::missingFloorLayer() const

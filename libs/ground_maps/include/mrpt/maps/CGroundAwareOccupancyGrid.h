@@ -3,6 +3,7 @@
 
 #include <map>
 #include <string>
+#include <unordered_map>
 
 #include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
@@ -69,6 +70,12 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		 * on, 2D scans add their hits and make no cell freer: only floor the
 		 * depth camera saw is free (off: MRPT's beam model). */
 		bool scan_keeps_3d_obstacles = true;
+		/** > 0: a positive obstacle (something sticking out of the floor, or a
+		 * 2D scan's hit) not re-observed as an obstacle for this many seconds
+		 * returns to unknown -- people who left. Never a negative obstacle
+		 * (hole, drop) or missing floor: those cannot walk away. 0 = off (the
+		 * default, as STVL's voxel_decay): obstacles stay until seen free. [s] */
+		double obstacle_decay_s = 0;
 		/** The online check of the declared sensor mount (height, pitch, roll)
 		 * against every frame's floor, and the option to map with the measured one. */
 		gam::MountCheckParams mount;
@@ -84,6 +91,11 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 			visit(
 				gam::ParamInfo{"scan_keeps_3d_obstacles", 0, 1, "2D scans add their hits and free no cell"},
 				o.scan_keeps_3d_obstacles);
+			visit(
+				gam::ParamInfo{
+					"obstacle_decay_s", 0, 1e9,
+					"positive obstacles not re-observed for this long return to unknown [s]; 0 = never"},
+				o.obstacle_decay_s);
 			gam::MountCheckParams::forEachParam(o.mount, visit);
 		}
 		/** Loads and validates (throws std::invalid_argument naming the key). */
@@ -156,6 +168,12 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	void applyEvidence();
 	/** Gives the missing-floor layer this grid's geometry (cells kept). */
 	void syncMissingLayer() const;
+	/** obstacle_decay_s: records positive obstacle cells seen at time `t`,
+	 * forgets negative ones, and returns to unknown the positive ones older
+	 * than the decay time. */
+	void notePositive(int cx, int cy, double t);
+	void noteNegative(int cx, int cy);
+	void decayObstacles(double t);
 
 	TGroundAwareOptions m_options;
 	// The method and its per-frame workspace (not serialized).
@@ -164,6 +182,9 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	std::map<std::string, gam::MountMonitor> m_mounts;  // not serialized: state of a run
 	std::string m_lastSensorLabel;
 	mutable COccupancyGridMap2D m_missingLayer;
+	// obstacle_decay_s: last time each positive obstacle cell was seen as one,
+	// keyed by its world cell (stable when the grid grows). Not serialized.
+	std::unordered_map<int64_t, double> m_positiveSeen;
 };
 
 }  // namespace mrpt::maps
