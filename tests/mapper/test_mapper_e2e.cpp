@@ -3,6 +3,7 @@
 #include <gam/eval/Evaluation.h>
 #include <gam/maps/GridIO.h>
 #include <gtest/gtest.h>
+
 #include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -16,6 +17,7 @@
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
+#include <algorithm>
 
 #include <unistd.h>
 
@@ -293,7 +295,7 @@ void checkOutputs(const std::string& dir)
 		std::ifstream f(dir + "/ground_planes.csv");
 		std::string h;
 		std::getline(f, h);
-		EXPECT_EQ(h, "frame,a,b,c,d,nodes,status,mount_z,mount_pitch_deg,mount_roll_deg,mount_alarm");
+		EXPECT_EQ(h, "frame,a,b,c,d,nodes,status,mount_z,mount_pitch_deg,mount_roll_deg,mount_alarm,sensor");
 	}
 	{
 		std::ifstream f(dir + "/timing.csv");
@@ -370,6 +372,8 @@ TEST(MapperReal, MilkBottlesAllOutputsParseAndMatch)
 	std::getline(f, h);
 	ASSERT_TRUE(std::getline(f, row));
 	EXPECT_NE(row.find(",ok"), std::string::npos) << row;
+	EXPECT_EQ(std::count(row.begin(), row.end(), ','), 11) << "12 columns, the last the camera's label: " << row;
+	EXPECT_NE(row.back(), ',') << row;
 	// The bottles (0.21-0.26 m tall, 0.5-0.8 m ahead) are obstacles in the ground-aware grid.
 	const auto g = readGridmapGz(out + "/ground_aware.gridmap.gz");
 	EXPECT_GT(fractionOccupied(g, 0.4, 0.9, -0.4, 0.4), 0.0);

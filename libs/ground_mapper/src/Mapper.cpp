@@ -190,7 +190,7 @@ RunSummary Mapper::run()
 	std::ofstream timing(tmp.path + "/timing.csv"), planes(tmp.path + "/ground_planes.csv");
 	if (!timing || !planes) throw RunError("cannot write to " + tmp.path);
 	timing << "frame,map,stage,ms\n";
-	planes << "frame,a,b,c,d,nodes,status,mount_z,mount_pitch_deg,mount_roll_deg,mount_alarm\n";
+	planes << "frame,a,b,c,d,nodes,status,mount_z,mount_pitch_deg,mount_roll_deg,mount_alarm,sensor\n";
 	planes << std::setprecision(9);
 	timing << std::fixed << std::setprecision(4);
 	// Snapshots (--snapshot-every N): written into the temporary folder too,
@@ -293,7 +293,8 @@ RunSummary Mapper::run()
 							   << (gp.mount_alarm ? 1 : 0);
 					else
 						planes << ",,,";
-					planes << "\n";
+					// Several cameras: each frame's plane is its own camera's.
+					planes << "," << fr.obs->sensorLabel << "\n";
 				}
 			}
 
