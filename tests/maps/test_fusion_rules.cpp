@@ -35,7 +35,8 @@ const Box kBox{1.6, -0.15, 0.0, 1.9, 0.15, 0.2};
 std::vector<Box> floorAnd(const std::vector<Box>& extra, bool hole = false)
 {
 	// A 0.4 x 0.4 m pit 0.3 m deep at x 2.4-2.8, y 0.4-0.8 when `hole`.
-	auto s = hole ? testscene::floorWithHole(-6, 8, -6, 6, 2.4, 2.8, 0.4, 0.8, 0.3) : testscene::floorWithHole(-6, 8, -6, 6);
+	auto s =
+		hole ? testscene::floorWithHole(-6, 8, -6, 6, 2.4, 2.8, 0.4, 0.8, 0.3) : testscene::floorWithHole(-6, 8, -6, 6);
 	for (const Box& b : extra) s.push_back(b);
 	return s;
 }
