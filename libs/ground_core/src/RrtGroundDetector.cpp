@@ -131,6 +131,7 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 		return;
 	}
 	const GridGeometry& g = grid.geometry();
+	m_resolution = g.resolution;
 	m_rng.seed(m_params.random_seed);
 	reserveScratch(g);
 
@@ -171,7 +172,92 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 		return;
 	}
 	fitPlanes(out);
+	if (m_params.variant != MethodVariant::Paper && m_params.fill_patches && !out.planes.empty())
+	{
+		const Plane ground = out.planes.front();
+		const size_t treeNodes = out.nodes.size();
+		fillPatches(grid, ground, out);
+		out.fill_nodes = out.nodes.size() - treeNodes;
+		if (out.fill_nodes)
+		{
+			// Fit again with the filled patches (the ground plane holds the seed either way).
+			out.planes.clear();
+			out.plane_support.clear();
+			for (GroundNode& n : out.nodes) n.plane_id = -1;
+			fitPlanes(out);
+		}
+	}
 	out.status = out.planes.empty() ? GroundDetection::Status::NoConsensus : GroundDetection::Status::Ok;
+}
+
+void RrtGroundDetector::fillPatches(const ElevationGrid& grid, const Plane& ground, GroundDetection& out)
+{
+	// Breadth-first from every node off the ground plane (a ramp or a landing
+	// the tree reached): candidates s_x (along x) and s_y (along y) cells away
+	// in the 8 directions, so that neighbouring nodes' fit windows tile the
+	// surface without overlapping; a candidate whose window already holds a
+	// node is skipped. A new node passes the tree's tests against its parent
+	// (E_th, max_fit_rms, N_th); it is expanded in turn only while it is off
+	// the ground plane or tilted away from it (offGround), so the filling
+	// stops where the patch meets the floor again. At most K + 1 nodes in
+	// all: the capacity the tree has reserved.
+	const GridGeometry& g = grid.geometry();
+	const size_t cap = maxTreeNodes(g);  // the capacity reserved for the tree: no allocation
+	const int sx = m_params.neighbourhood_x, sy = m_params.neighbourhood_y, hx = sx / 2, hy = sy / 2;
+	const double off = m_params.ransac_inlier_distance;
+	// A node grows the patch if it is off the ground plane, or if its local
+	// plane leaves the ground plane by more than that within d_n (the foot of
+	// a ramp, still on the floor, tilted with the ramp: often the only node
+	// the tree put on a ramp seen from afar). Floor nodes whose local fit is
+	// tilted by noise add a few nodes on the floor, which stop there.
+	const double reach = m_params.expansion_distance;
+	const Eigen::Vector3d gn = ground.normal();
+	auto offGround = [&](const GroundNode& n) {
+		if (std::abs(ground.signedDistance(n.x, n.y, n.z)) > off) return true;
+		// Height of the local plane over the ground plane, d_n away along the
+		// local plane's steepest direction relative to the ground's.
+		const Eigen::Vector3d ln = n.local.normal();
+		const double s = ln.cross(gn).norm();  // sin of the angle between the planes
+		return reach * s / std::max(1e-9, std::sqrt(std::max(0.0, 1.0 - s * s))) > off;
+	};
+	auto windowFree = [&](int cx, int cy) {
+		for (int y = std::max(0, cy - hy); y <= std::min(g.ny - 1, cy + hy); y++)
+			for (int x = std::max(0, cx - hx); x <= std::min(g.nx - 1, cx + hx); x++)
+				if (m_hasNode[g.index(x, y)]) return false;
+		return true;
+	};
+	static constexpr int kDirs[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {1, -1}, {-1, 1}, {-1, -1}};
+	m_fillQueue.clear();
+	for (uint32_t i = 0; i < out.nodes.size(); i++)
+		if (offGround(out.nodes[i])) m_fillQueue.push_back(i);
+	for (size_t q = 0; q < m_fillQueue.size() && out.nodes.size() < cap; q++)
+	{
+		const uint32_t pi = m_fillQueue[q];
+		const GroundNode parent = out.nodes[pi];  // a copy: addTreeNode() appends to out.nodes
+		const int pcx = g.ix(parent.x), pcy = g.iy(parent.y);
+		for (const auto& d : kDirs)
+		{
+			if (out.nodes.size() >= cap) break;
+			const int cx = pcx + d[0] * sx, cy = pcy + d[1] * sy;
+			if (!g.inside(cx, cy) || !windowFree(cx, cy)) continue;
+			float z;
+			if (!cellHeight(grid, cx, cy, z)) continue;
+			const double px = g.cx(cx), py = g.cy(cy);
+			if (std::abs(double(z) - parent.local.heightAt(px, py)) > m_params.elevation_threshold) continue;
+			Plane pl;
+			double rms;
+			if (!fitLocalPlane(grid, cx, cy, pl, rms)) continue;
+			if (rms > m_params.max_fit_rms || pl.horizontalNormal() > m_params.normal_threshold) continue;
+			GroundNode node;
+			node.x = float(px);
+			node.y = float(py);
+			node.z = float(pl.heightAt(px, py));
+			node.local = pl;
+			node.parent = int(pi);
+			addTreeNode(g, node, cx, cy, out);
+			if (offGround(node)) m_fillQueue.push_back(uint32_t(out.nodes.size() - 1));
+		}
+	}
 }
 
 size_t RrtGroundDetector::maxTreeNodes(const GridGeometry& g) const
@@ -197,6 +283,10 @@ void RrtGroundDetector::reserveScratch(const GridGeometry& g)
 	m_ransac.inliers.reserve(maxNodes);
 	m_fitPts.reserve(size_t(m_params.neighbourhood_x) * size_t(m_params.neighbourhood_y));
 	m_candidates.reserve(maxNodes);
+	m_fillQueue.reserve(maxNodes);
+	m_absDist.reserve(maxNodes);
+	m_cluster.reserve(maxNodes);
+	m_bfs.reserve(maxNodes);
 	if (m_hasNode.size() != g.cellCount())
 	{
 		m_hasNode.assign(g.cellCount(), 0);
@@ -462,6 +552,116 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 	}
 }
 
+bool RrtGroundDetector::groundFromSeed(
+	const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp)
+{
+	// pts are the nodes in order: pts[0] is the seed. The nodes' noise about
+	// the seed's local plane (sigma = 1.4826 x the median absolute distance
+	// of those within the inlier distance) sets a tight band, 3 sigma + the
+	// cell quantisation (see noiseBand); the plane is refitted (total least
+	// squares) to the nodes inside that band, which then holds the nodes the
+	// better plane brings in, until the set stops changing. Refitting to all
+	// nodes within the 2.5 cm instead let the foot of a wide ramp (its first
+	// 25 cm at 6 deg) tilt the floor toward it, which took in more of it.
+	Plane pl = out.nodes.front().local;
+	m_absDist.clear();
+	for (const Eigen::Vector3d& q : pts)
+	{
+		const double d = std::abs(pl.signedDistance(q.x(), q.y(), q.z()));
+		if (d <= rp.inlier_distance) m_absDist.push_back(d);
+	}
+	if (m_absDist.size() < 3) return false;
+	const double band = noiseBand(rp.inlier_distance);
+	size_t last = 0;
+	for (int it = 0; it < 20; it++)
+	{
+		m_ransacInliers.clear();
+		for (const Eigen::Vector3d& q : pts)
+			if (std::abs(pl.signedDistance(q.x(), q.y(), q.z())) <= band) m_ransacInliers.push_back(q);
+		if (m_ransacInliers.size() == last || m_ransacInliers.size() < 3) break;
+		last = m_ransacInliers.size();
+		const auto refined = fitPlaneTotalLeastSquares(m_ransacInliers);
+		if (!refined || refined->horizontalNormal() > rp.max_horizontal_normal) break;
+		pl = *refined;
+	}
+	// Its nodes: all within the inlier distance, as for any plane.
+	m_ransac.inliers.clear();
+	for (size_t i = 0; i < pts.size(); i++)
+		if (std::abs(pl.signedDistance(pts[i].x(), pts[i].y(), pts[i].z())) <= rp.inlier_distance)
+			m_ransac.inliers.push_back(i);
+	if (m_ransac.inliers.size() < std::max<size_t>(3, rp.min_inliers)) return false;
+	m_ransac.plane = pl;
+	return true;
+}
+
+double RrtGroundDetector::noiseBand(double cap)
+{
+	// 3 sigma of the distances in m_absDist (sigma = 1.4826 x their median:
+	// robust to the few that belong to something else), plus the most a
+	// cell's mean can sit off a plane tilted by N_th at the cell centre
+	// (d_r / 2 * tan(asin N_th): 5 mm at 5 cm and 11.5 deg); at most `cap`.
+	// Reorders m_absDist.
+	if (m_absDist.empty()) return cap;
+	auto mid = m_absDist.begin() + long(m_absDist.size() / 2);
+	std::nth_element(m_absDist.begin(), mid, m_absDist.end());
+	const double sigma = 1.4826 * *mid;
+	const double nth = std::min(m_params.normal_threshold, 0.999);
+	return std::min(cap, 3.0 * sigma + 0.5 * m_resolution * nth / std::sqrt(1.0 - nth * nth));
+}
+
+void RrtGroundDetector::keepLargestCluster(const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp)
+{
+	// A patch is one connected surface: nodes link when they are at most d_n
+	// apart (the tree's longest step; filled nodes are s_x cells apart). A
+	// plane's consensus can gather distant groups at the same height (the top
+	// of a cable protector on one side of the robot and the middle of a ramp
+	// on the other: one 4 cm "patch" that freed both).
+	std::vector<size_t>& in = m_ransac.inliers;
+	const size_t n = in.size();
+	const double link2 = m_params.expansion_distance * m_params.expansion_distance;
+	m_cluster.assign(n, -1);
+	int best = -1, nClusters = 0;
+	size_t bestSize = 0;
+	for (size_t s0 = 0; s0 < n; s0++)
+	{
+		if (m_cluster[s0] >= 0) continue;
+		const int c = nClusters++;
+		m_bfs.clear();
+		m_bfs.push_back(s0);
+		m_cluster[s0] = c;
+		for (size_t h = 0; h < m_bfs.size(); h++)
+		{
+			const Eigen::Vector3d& a = pts[in[m_bfs[h]]];
+			for (size_t j = 0; j < n; j++)
+			{
+				if (m_cluster[j] >= 0) continue;
+				const Eigen::Vector3d& b = pts[in[j]];
+				const double dx = a.x() - b.x(), dy = a.y() - b.y();
+				if (dx * dx + dy * dy > link2) continue;
+				m_cluster[j] = c;
+				m_bfs.push_back(j);
+			}
+		}
+		if (m_bfs.size() > bestSize)
+		{
+			bestSize = m_bfs.size();
+			best = c;
+		}
+	}
+	if (nClusters <= 1) return;
+	size_t w = 0;
+	m_ransacInliers.clear();
+	for (size_t i = 0; i < n; i++)
+		if (m_cluster[i] == best)
+		{
+			in[w++] = in[i];
+			m_ransacInliers.push_back(pts[in[i]]);
+		}
+	in.resize(w);
+	const auto refined = fitPlaneTotalLeastSquares(m_ransacInliers);
+	if (refined && refined->horizontalNormal() <= rp.max_horizontal_normal) m_ransac.plane = *refined;
+}
+
 void RrtGroundDetector::fitPlanes(GroundDetection& out)
 {
 	// RANSAC over the node centres gives the ground plane; further RANSAC rounds
@@ -489,14 +689,37 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 
 	// The paper fits one plane: the ground.
 	const int maxPlanes = m_params.variant == MethodVariant::Paper ? 1 : m_params.max_planes;
-	for (int k = 0; k < maxPlanes && remaining.size() >= 3; k++)
+	// A round whose consensus is no patch (a line of nodes, scattered nodes)
+	// removes those nodes but takes no plane's place; at most 2 x max_planes
+	// rounds.
+	for (int round = 0; int(out.planes.size()) < maxPlanes && remaining.size() >= 3 && round < 2 * maxPlanes; round++)
 	{
+		const int k = int(out.planes.size());
 		rp.min_inliers = k == 0 ? std::max<size_t>(3, m_params.min_nodes / 2) : m_params.min_nodes_per_extra_plane;
 		if (k > 0 && m_params.min_nodes_per_extra_plane == 0) break;
 		pts.clear();
 		for (size_t i : remaining) pts.emplace_back(out.nodes[i].x, out.nodes[i].y, out.nodes[i].z);
-		if (!fitPlaneRansac(pts, rp, m_rng, m_ransac, m_ransacInliers)) break;
+		// The ground plane is the one the seed (the floor under the robot,
+		// node 0) lies on, not the largest consensus (the paper's): a ramp
+		// and its landing in view can hold more nodes than the floor (in
+		// ramp_6deg the ramp was the ground plane in 2 of 11 frames, and the
+		// floor around the robot an obstacle), and so can a plane through the
+		// seed tilted onto them. So it grows from the seed's own local plane
+		// (groundFromSeed). If that plane lacks the support, the largest
+		// consensus.
+		bool found = k == 0 && m_params.variant != MethodVariant::Paper && groundFromSeed(out, pts, rp);
+		if (!found) found = fitPlaneRansac(pts, rp, m_rng, m_ransac, m_ransacInliers);
+		if (!found) break;
+		if (k > 0) keepLargestCluster(pts, rp);
 		const RansacResult& r = m_ransac;
+		if (r.inliers.size() < std::max<size_t>(3, rp.min_inliers))
+		{
+			// Scattered consensus without a patch of the size: those nodes are no patch.
+			m_flag.assign(remaining.size(), 0);
+			for (size_t i : r.inliers) m_flag[i] = 1;
+			keepUnflagged();
+			continue;
+		}
 
 		Plane plane = r.plane;
 		// Nearly collinear node sets (a corridor crossed by one line of nodes)
@@ -515,8 +738,14 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		const double minorStd =
 			std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(C).eigenvalues()(0)));
 		// An extra patch must be an area, not a line of nodes along the top of
-		// a cable protector or a kerb: those are obstacles, not ground.
-		const bool lineLike = minorStd < 0.25 * m_params.expansion_distance;
+		// a cable protector or a kerb: those are obstacles, not ground. Area:
+		// wider than two local-fit windows side by side (nodes in two
+		// adjacent columns of windows have a minor std of half a window,
+		// 7.5 cm; a 25 cm cable protector holds two at most). It was d_n / 4
+		// (10 cm), which refused the part of a 0.8 m ramp a camera sees from
+		// its side (13 nodes, 9.5 cm).
+		const double window = std::max(m_params.neighbourhood_x, m_params.neighbourhood_y) * m_resolution;
+		const bool lineLike = minorStd <= 0.5 * window;
 		if (k > 0 && lineLike)
 		{
 			m_flag.assign(remaining.size(), 0);
@@ -535,6 +764,22 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 			plane = Plane::fromNormalAndPoint(n, c / double(r.inliers.size()));
 		}
 
+		if (k == 0)
+		{
+			// The extra patches' inlier distance, from this frame's noise and
+			// the grid: the ground plane's own nodes' noise band about it (see
+			// noiseBand; the ramp-foot nodes inside its 2.5 cm do not inflate a
+			// median). With the ground plane's 2.5 cm, one plane halfway
+			// between a 6 deg ramp and its flat landing held the nodes of both
+			// (a 3 deg compromise, up to 2.5 cm off either, which ate the
+			// ground band and hid a 4 cm cable on the ramp) and beat either
+			// true plane.
+			m_absDist.clear();
+			for (size_t i : r.inliers)
+				m_absDist.push_back(std::abs(plane.signedDistance(pts[i].x(), pts[i].y(), pts[i].z())));
+			rp.inlier_distance = noiseBand(m_params.ransac_inlier_distance);
+			out.patch_inlier_distance = rp.inlier_distance;
+		}
 		const int id = int(out.planes.size());
 		out.planes.push_back(plane);
 		out.plane_support.push_back(r.inliers.size());

@@ -58,7 +58,20 @@ struct RrtGpdParams
 	double ransac_inlier_distance = 0.025;  ///< [m]
 	/** Extra planes (ramps) need this many supporting nodes; 0 disables them. */
 	size_t min_nodes_per_extra_plane = 3;
-	int max_planes = 3;
+	/** The ground plane + extra patches. A ramp with a landing and a way down
+	 * is three patches next to the floor (see fill_patches). */
+	int max_planes = 4;
+	/** After the tree: from every node off the ground plane (a ramp or landing
+	 * the tree climbed onto) or whose local plane leaves it by more than
+	 * ransac_inlier_distance within d_n (a ramp's foot), add nodes s_x by s_y
+	 * cells apart in the 8 directions, with the tree's own tests (E_th
+	 * against the parent's local plane, max_fit_rms, N_th), until the surface
+	 * meets the ground plane again or the tree has K + 1 nodes. The random
+	 * tree puts a node every ~d_n and reaches a narrow ramp only through its
+	 * foot: a 0.7 m wide 8 deg ramp got 0-5 nodes in most frames, too few (and
+	 * too collinear) for a patch of its own; filled, its nodes tile it with
+	 * their own fit windows. Not in the paper variant. */
+	bool fill_patches = true;
 	uint32_t random_seed = 1;
 
 	/** The .ini keys (paper Table I names), ranges and meanings (Parameters.h). */
@@ -93,6 +106,11 @@ struct RrtGpdParams
 			ParamInfo{"min_nodes_per_extra_plane", 0, 1000000, "nodes an extra ground patch (ramp) needs; 0 = none"},
 			p.min_nodes_per_extra_plane);
 		visit(ParamInfo{"max_planes", 1, 8, "ground plane + extra patches"}, p.max_planes);
+		visit(
+			ParamInfo{
+				"fill_patches", 0, 1,
+				"add nodes s_x x s_y cells apart over ground off the main plane (ramps), with the tree's tests"},
+			p.fill_patches);
 		visit(ParamInfo{"random_seed", 0, 2147483647, "RNG seed (same seed, same result)"}, p.random_seed);
 	}
 	/** Throws std::invalid_argument naming the parameter out of range. */
@@ -118,11 +136,21 @@ struct GroundDetection
 		NoConsensus   ///< RANSAC found no plane among the nodes
 	};
 	Status status = Status::EmptyGrid;
-	/** planes[0] is the ground plane; later ones are smaller ground patches
-	 * (ramps) supported by at least min_nodes_per_extra_plane nodes. */
+	/** planes[0] is the ground plane: the plane the seed (the floor under the
+	 * robot) lies on, grown from the seed's local plane, even when a ramp or
+	 * landing in view has more nodes (the paper variant: the largest RANSAC
+	 * consensus). Later ones are smaller ground patches (ramps): connected
+	 * areas of at least min_nodes_per_extra_plane nodes. */
 	std::vector<Plane> planes;
 	std::vector<size_t> plane_support;  ///< nodes per plane
-	std::vector<GroundNode> nodes;
+	std::vector<GroundNode> nodes;      ///< nodes[0] is the seed; fill_patches nodes follow the tree's
+	size_t fill_nodes = 0;              ///< nodes added by fill_patches (the last ones)
+	/** The inlier distance the extra patches were fitted with [m]: 3 sigma of
+	 * the ground plane's nodes about it (1.4826 x their median absolute
+	 * distance) + d_r / 2 * tan(asin N_th), at most ransac_inlier_distance.
+	 * The ground plane itself is refitted to its nodes within the same kind
+	 * of band about the seed's local plane. */
+	double patch_inlier_distance = 0;
 	int iterations = 0;
 
 	bool ok() const { return status == Status::Ok; }
@@ -135,6 +163,8 @@ struct GroundDetection
 		planes.clear();
 		plane_support.clear();
 		nodes.clear();
+		fill_nodes = 0;
+		patch_inlier_distance = 0;
 		iterations = 0;
 	}
 	static const char* statusName(Status s);
@@ -218,6 +248,22 @@ class RrtGroundDetector
 	void growTreePaper(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
 	std::vector<std::pair<float, uint32_t>> m_candidates;  ///< paper fallback: (distance^2, node)
 	void fitPlanes(GroundDetection& out);
+	/** The ground plane grown from the seed's local plane (see fitPlanes);
+	 * false if it has fewer than rp.min_inliers nodes. Into m_ransac. */
+	bool groundFromSeed(const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
+	/** Keeps, of m_ransac's inliers, the largest group linked by steps of at
+	 * most d_n, and refits its plane (see fitPlanes). */
+	void keepLargestCluster(const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
+	/** 3 sigma of the distances in m_absDist (robust) + the cell quantisation
+	 * d_r / 2 * tan(asin N_th), at most `cap` (see fitPlanes). */
+	double noiseBand(double cap);
+	std::vector<int> m_cluster;
+	std::vector<size_t> m_bfs;
+	/** fill_patches: adds nodes over the ground off `ground` (see RrtGpdParams). */
+	void fillPatches(const ElevationGrid& grid, const Plane& ground, GroundDetection& out);
+	std::vector<uint32_t> m_fillQueue;
+	double m_resolution = 0.05;  ///< of the grid in detect() [m]
+	std::vector<double> m_absDist;
 	void reserveScratch(const GridGeometry& g);
 	size_t maxTreeNodes(const GridGeometry& g) const;
 
