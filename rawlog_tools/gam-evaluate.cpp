@@ -5,6 +5,8 @@
 // usage: gam-evaluate --map DIR/ground_aware.yaml [--map DIR/octomap.yaml ...]
 //                     --gt PREFIX [--json FILE] [--csv FILE] [--png FILE]
 //                     [--tolerance-cells 1] [--min-hits 1] [--title TEXT]
+//                     [--sequence [--ghost-frames 10] [--view-margin-cells 1]
+//                      [--sequence-json FILE] [--sequence-csv FILE]]
 // exit: 0 ok, 1 missing or bad input / unwritable output, 2 command line.
 #include <gam/common/CommandLine.h>
 #include <gam/common/Version.h>
@@ -179,6 +181,23 @@ int main(int argc, char** argv)
 		cmd);
 	TCLAP::ValueArg<int> argHits(
 		"", "min-hits", "occupied cells an object needs to be detected (default 1)", false, 1, "N", cmd);
+	TCLAP::SwitchArg argSequence(
+		"", "sequence",
+		"also score each map after every frame: DIR/snapshots/ of each --map DIR/LABEL.yaml (ground-aware-mapper "
+		"--snapshot-every) against PREFIX_gt_frames.csv (ghost cells, time to clear, hazards out of view, changes "
+		"outside the view, per-frame scores)",
+		cmd);
+	TCLAP::ValueArg<int> argGhost(
+		"", "ghost-frames",
+		"--sequence: a cell still occupied this many frames after seen free is a ghost (default 10)", false, 10, "N",
+		cmd);
+	TCLAP::ValueArg<int> argMargin(
+		"", "view-margin-cells", "--sequence: cells this close to a frame's footprint count as in view (default 1)",
+		false, 1, "N", cmd);
+	TCLAP::ValueArg<std::string> argSeqJson(
+		"", "sequence-json", "--sequence: write its numbers (per frame too) as JSON", false, "", "FILE", cmd);
+	TCLAP::ValueArg<std::string> argSeqCsv(
+		"", "sequence-csv", "--sequence: write the per-frame scores as CSV", false, "", "FILE", cmd);
 	TCLAP::SwitchArg argQuiet("q", "quiet", "no table on stdout", cmd);
 	if (const int rc = gam::parseCommandLine(cmd, argc, argv, "gam-evaluate"); rc >= 0) return rc;
 	Options opt;
@@ -187,6 +206,20 @@ int main(int argc, char** argv)
 	if (opt.tolerance_cells < 0 || opt.tolerance_cells > 20 || opt.min_hits < 1)
 	{
 		std::cerr << "gam-evaluate: error: --tolerance-cells must be in [0, 20] and --min-hits >= 1\n";
+		return 2;
+	}
+	SequenceOptions seqOpt;
+	seqOpt.ghost_frames = argGhost.getValue();
+	seqOpt.view_margin_cells = argMargin.getValue();
+	seqOpt.tolerance_cells = opt.tolerance_cells;
+	if (seqOpt.ghost_frames < 0 || seqOpt.view_margin_cells < 0 || seqOpt.view_margin_cells > 20)
+	{
+		std::cerr << "gam-evaluate: error: --ghost-frames must be >= 0 and --view-margin-cells in [0, 20]\n";
+		return 2;
+	}
+	if (!argSequence.getValue() && (!argSeqJson.getValue().empty() || !argSeqCsv.getValue().empty()))
+	{
+		std::cerr << "gam-evaluate: error: --sequence-json and --sequence-csv need --sequence\n";
 		return 2;
 	}
 	try
@@ -213,6 +246,28 @@ int main(int argc, char** argv)
 		if (!argJson.getValue().empty()) writeText(argJson.getValue(), toJson(gt, scores, opt));
 		if (!argCsv.getValue().empty()) writeText(argCsv.getValue(), toCsv(scores));
 		if (!argPng.getValue().empty()) writePng(argPng.getValue(), argTitle.getValue(), gt, maps, scores);
+		if (argSequence.getValue())
+		{
+			// Issue #14: every map after every frame, from its run's snapshots.
+			namespace fs = std::filesystem;
+			const SequenceTruth seq = loadSequenceTruth(argGt.getValue(), gt);
+			std::vector<SequenceScore> seqScores;
+			for (size_t m = 0; m < maps.size(); m++)
+			{
+				const fs::path y(maps[m].yamlPath);
+				const fs::path dir = y.parent_path().empty() ? fs::path(".") : y.parent_path();
+				const std::vector<std::string> snaps = snapshotsPerFrame(seq, loadSnapshotIndex(dir.string()));
+				SequenceScore ss = evaluateSequence(
+					gt, seq,
+					[&](int f) { return loadRosMap((dir / "snapshots" / snaps[size_t(f)] / y.filename()).string()); },
+					seqOpt);
+				ss.name = scores[m].name;
+				seqScores.push_back(std::move(ss));
+			}
+			if (!argQuiet.getValue()) std::cout << formatSequenceTable(seqScores, seqOpt);
+			if (!argSeqJson.getValue().empty()) writeText(argSeqJson.getValue(), sequenceToJson(seqScores, seqOpt));
+			if (!argSeqCsv.getValue().empty()) writeText(argSeqCsv.getValue(), sequenceToCsv(seqScores));
+		}
 	}
 	catch (const std::exception& e)
 	{

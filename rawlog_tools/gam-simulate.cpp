@@ -5,7 +5,8 @@
 // usage: gam-simulate --scene FILE.scene --out PREFIX [--seed N] [--no-noise]
 //                     [--frames N] [--no-leddar] [--depth-images]
 // outputs: PREFIX.rawlog, PREFIX_gt.pgm, PREFIX_gt.yaml, PREFIX_gt_objects.csv,
-//          PREFIX_gt_labels.csv, PREFIX_gt_path.csv
+//          PREFIX_gt_labels.csv, PREFIX_gt_path.csv, PREFIX_gt_sensors.csv and, for
+//          scenes with motion or with --gt-frames, PREFIX_gt_frames.csv (per frame)
 #include <gam/common/CommandLine.h>
 #include <gam/common/Version.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -17,12 +18,14 @@
 #include <mrpt/poses/CPose3D.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include "gam/sim/GroundTruth.h"
 #include "gam/sim/KinectObservation.h"
@@ -67,6 +70,143 @@ std::string baseName(const std::string& p)
 	const auto s = p.find_last_of('/');
 	return s == std::string::npos ? p : p.substr(s + 1);
 }
+
+/** PREFIX_gt_frames.csv, the per-frame ground truth (issue #14; format in
+ * config/scenes/README.md): per frame the rawlog entries it wrote, the cells whose
+ * geometric label changed (all non-free cells in frame 0), the cells each depth
+ * camera saw (true footprint), the cells its measured, noisy points fell into and the
+ * cells the Leddar's beams swept, as runs along grid rows. */
+class FrameTruthWriter
+{
+   public:
+	FrameTruthWriter(const std::string& path, const GridSpec& g) : m_f(path), m_g(g)
+	{
+		const size_t n = size_t(g.nx()) * size_t(g.ny());
+		m_label.assign(n, Label::Free);
+		m_obj.assign(n, 0);
+		m_mask.assign(n, 0);
+		m_f << "frame,kind,iy,ix0,ix1,label,object_id\n";
+	}
+	void entries(size_t frame, size_t first, size_t last)
+	{
+		m_f << frame << ",entries,0," << first << "," << last << ",,0\n";
+	}
+	/** The cells of rows y0..y1, columns x0..x1 whose label or object differs from the
+	 * last written state. */
+	void geometry(size_t frame, const GroundTruthGrid& gt, int x0, int y0, int x1, int y1)
+	{
+		for (int iy = y0; iy <= y1; iy++)
+		{
+			int run = -1;
+			for (int ix = x0; ix <= x1 + 1; ix++)
+			{
+				const bool ch = ix <= x1 && differs(gt, ix, iy);
+				const size_t i = gt.idx(std::min(ix, x1), iy);
+				if (run >= 0 && (!ch || gt.geomLabel[i] != gt.geomLabel[gt.idx(run, iy)] ||
+								 gt.objectId[i] != gt.objectId[gt.idx(run, iy)]))
+				{
+					const size_t r = gt.idx(run, iy);
+					m_f << frame << ",geom," << iy << "," << run << "," << ix - 1 << "," << labelName(gt.geomLabel[r])
+						<< "," << gt.objectId[r] << "\n";
+					run = -1;
+				}
+				if (ch && run < 0) run = ix;
+			}
+			for (int ix = x0; ix <= x1; ix++)
+			{
+				m_label[gt.idx(ix, iy)] = gt.geomLabel[gt.idx(ix, iy)];
+				m_obj[gt.idx(ix, iy)] = gt.objectId[gt.idx(ix, iy)];
+			}
+		}
+	}
+	/** Marks the cells holding these world points (seen by a depth camera). */
+	void see(const GroundTruthGrid& gt, const std::vector<Eigen::Vector2d>& pts, uint8_t bit)
+	{
+		int ix, iy;
+		for (const auto& p : pts)
+			if (gt.cellOf(p.x(), p.y(), ix, iy)) mark(gt.idx(ix, iy), bit);
+	}
+	/** Marks the cells of the measured (noisy) points of a depth frame: its valid
+	 * pixels unprojected with the pose the camera really had. */
+	void seePoints(const GroundTruthGrid& gt, const KinectModel& km, const DepthFrame& fr, const Pose3& sensor)
+	{
+		int ix, iy;
+		for (int r = 0; r < fr.height; r++)
+			for (int c = 0; c < fr.width; c++)
+			{
+				const float d = fr.depth[fr.idx(r, c)];
+				if (!(d > 0)) continue;
+				const Eigen::Vector3d p = sensor.apply(double(d) * km.pixelRay(r, c));
+				if (gt.cellOf(p.x(), p.y(), ix, iy)) mark(gt.idx(ix, iy), 4);
+			}
+	}
+	/** Marks the cells along the 2D segment a -> b (clipped to the grid). */
+	void sweep(const GroundTruthGrid& gt, const Eigen::Vector2d& a, const Eigen::Vector2d& b, uint8_t bit)
+	{
+		const double len = (b - a).norm(), step = 0.5 * m_g.resolution;
+		int ix, iy;
+		for (double t = 0; t <= len; t += step)
+		{
+			const Eigen::Vector2d p = a + (b - a) * (len > 0 ? t / len : 0.0);
+			if (gt.cellOf(p.x(), p.y(), ix, iy))
+				mark(gt.idx(ix, iy), bit);
+			else if (t > 0)
+				break;  // left the grid
+		}
+	}
+	/** Writes the marked cells of this frame as `view` (bit 1), `points` (bit 4) and
+	 * `leddar` (bit 2) runs and clears the marks. */
+	void flush(size_t frame)
+	{
+		std::sort(m_touched.begin(), m_touched.end());
+		const size_t nx = size_t(m_g.nx());
+		for (uint8_t bit : {uint8_t(1), uint8_t(4), uint8_t(2)})
+		{
+			const char* kind = bit == 1 ? "view" : (bit == 2 ? "leddar" : "points");
+			size_t k = 0;
+			while (k < m_touched.size())
+			{
+				const size_t i = m_touched[k];
+				if (!(m_mask[i] & bit))
+				{
+					k++;
+					continue;
+				}
+				size_t j = k;
+				while (j + 1 < m_touched.size() && m_touched[j + 1] == m_touched[j] + 1 &&
+					   m_touched[j + 1] / nx == i / nx && (m_mask[m_touched[j + 1]] & bit))
+					j++;
+				m_f << frame << "," << kind << "," << i / nx << "," << i % nx << "," << m_touched[j] % nx << ",,0\n";
+				k = j + 1;
+			}
+		}
+		for (size_t i : m_touched) m_mask[i] = 0;
+		m_touched.clear();
+	}
+	void close()
+	{
+		m_f.flush();
+		if (!m_f) throw std::runtime_error("cannot write the per-frame ground truth");
+	}
+
+   private:
+	bool differs(const GroundTruthGrid& gt, int ix, int iy) const
+	{
+		const size_t i = gt.idx(ix, iy);
+		return gt.geomLabel[i] != m_label[i] || gt.objectId[i] != m_obj[i];
+	}
+	void mark(size_t i, uint8_t bit)
+	{
+		if (!m_mask[i]) m_touched.push_back(i);
+		m_mask[i] |= bit;
+	}
+	std::ofstream m_f;
+	GridSpec m_g;
+	std::vector<Label> m_label;
+	std::vector<int> m_obj;
+	std::vector<uint8_t> m_mask;
+	std::vector<size_t> m_touched;
+};
 
 void writeGroundTruth(const std::string& prefix, const SceneFile& sf, const GroundTruthGrid& gt)
 {
@@ -140,6 +280,11 @@ int main(int argc, char** argv)
 			"write the Kinect's sensorPose off the true one by dz,dpitch,droll [m, deg]: a wrong declared mount "
 			"(the frames are rendered with the true one)",
 			false, "", "DZ,DPITCH,DROLL", cmd);
+		TCLAP::SwitchArg argGtFrames(
+			"", "gt-frames",
+			"also write PREFIX_gt_frames.csv, the ground truth per frame (default: only when an object appears, "
+			"disappears or moves, or with the scene's grid per_frame=1)",
+			cmd);
 		TCLAP::SwitchArg argDepthPgm(
 			"", "depth-images", "also write PREFIX_depth_NNNN.pgm (16-bit, millimetres) per frame", cmd);
 		if (const int rc = gam::parseCommandLine(cmd, argc, argv, "gam-simulate"); rc >= 0) return rc;
@@ -173,6 +318,35 @@ int main(int argc, char** argv)
 
 		GroundTruthGrid gt;
 		gt.build(sf.scene, sf.grid);
+		// Moving objects (issue #14): each frame renders sf.scene.atFrame(i), and the
+		// ground truth is labelled again where an object appeared, left or moved; the
+		// final labels are those of the last frame.
+		const bool dynamic = sf.scene.dynamic();
+		const bool perFrame = argGtFrames.getValue() || sf.per_frame_truth == 1 || (sf.per_frame_truth < 0 && dynamic);
+		std::unique_ptr<FrameTruthWriter> frameTruth;
+		if (perFrame)
+		{
+			const std::filesystem::path parent = std::filesystem::path(prefix).parent_path();
+			std::error_code ec;
+			if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+			frameTruth = std::make_unique<FrameTruthWriter>(prefix + "_gt_frames.csv", gt.spec);
+		}
+		// Where object o is in frame f (empty box = absent); f = -1: as in the scene file.
+		auto placed = [&](const ObjectInfo& o, int f) {
+			if (f >= 0) return sf.scene.footprintAt(o.id, f);
+			Eigen::AlignedBox2d b(o.bbox.min().head<2>(), o.bbox.max().head<2>());
+			return b;
+		};
+		// Extra cameras: their own random streams, so the main camera's frames stay the same.
+		std::vector<KinectModel> moreKinects;
+		std::vector<std::mt19937> moreRng, moreSwayRng;
+		for (size_t j = 0; j < sf.more_kinects.size(); j++)
+		{
+			sf.more_kinects[j].params.noise = noise;
+			moreKinects.emplace_back(sf.more_kinects[j].params);
+			moreRng.emplace_back(seed ^ (0x27d4eb2du * unsigned(j + 1)));
+			moreSwayRng.emplace_back(seed ^ (0x165667b1u * unsigned(j + 1)));
+		}
 
 		const KinectModel kinect(sf.kinect);
 		const LeddarModel leddar(sf.leddar);
@@ -203,14 +377,20 @@ int main(int argc, char** argv)
 			if (!parent.empty()) std::filesystem::create_directories(parent, ec);
 			std::ofstream f(prefix + "_gt_sensors.csv");
 			f << "label,kind,x,y,z,yaw_deg,pitch_deg,roll_deg\n";
-			for (const auto& [kind, p] :
-				 {std::pair<const char*, Pose3>{"true", sf.kinect_pose}, {"declared", declared}})
+			std::vector<std::tuple<std::string, const char*, Pose3>> rows = {
+				{sf.kinect_label, "true", sf.kinect_pose}, {sf.kinect_label, "declared", declared}};
+			for (const auto& e : sf.more_kinects)
+			{
+				rows.emplace_back(e.label, "true", e.pose);
+				rows.emplace_back(e.label, "declared", e.pose);
+			}
+			for (const auto& [label, kind, p] : rows)
 			{
 				const Eigen::Vector3d a = p.ypr() * 180.0 / M_PI;
 				char b[200];
 				std::snprintf(
-					b, sizeof b, "KINECT,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", kind, p.t.x(), p.t.y(), p.t.z(), a[0],
-					a[1], a[2]);
+					b, sizeof b, "%s,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", label.c_str(), kind, p.t.x(), p.t.y(),
+					p.t.z(), a[0], a[1], a[2]);
 				f << b;
 			}
 			if (!f) throw std::runtime_error("cannot write " + prefix + "_gt_sensors.csv");
@@ -232,8 +412,41 @@ int main(int argc, char** argv)
 		std::ofstream pathCsv(prefix + "_gt_path.csv");
 		pathCsv << "frame,timestamp,x,y,yaw,odo_x,odo_y,odo_yaw\n";
 		size_t validPix = 0;
+		size_t entry = 0;  // rawlog entries written so far (the mapper's numbering)
+		Scene frameScene;
 		for (size_t i = 0; i < truth.size(); i++)
 		{
+			const size_t firstEntry = entry;
+			Eigen::AlignedBox2d changed;
+			changed.setEmpty();
+			if (dynamic)
+			{
+				frameScene = sf.scene.atFrame(int(i));
+				for (const auto& ob : sf.scene.objects)
+				{
+					if (!ob.dynamic()) continue;
+					const int prev = int(i) - 1;
+					const bool wasThere = prev < 0 || ob.presentAt(prev), isThere = ob.presentAt(int(i));
+					const Eigen::Vector2d offPrev = prev < 0 ? Eigen::Vector2d::Zero() : ob.offsetAt(prev);
+					if (wasThere == isThere && (!isThere || offPrev == ob.offsetAt(int(i)))) continue;
+					changed.extend(placed(ob, prev));
+					changed.extend(placed(ob, int(i)));
+				}
+				gt.relabel(frameScene, changed);
+			}
+			const Scene& scene = dynamic ? frameScene : sf.scene;
+			if (frameTruth && i == 0)
+				frameTruth->geometry(i, gt, 0, 0, gt.spec.nx() - 1, gt.spec.ny() - 1);
+			else if (frameTruth && !changed.isEmpty())
+			{
+				// the cells relabel() may have changed (one cell more around the region)
+				const double r = gt.spec.resolution;
+				const int x0 = std::max(0, int(std::floor((changed.min().x() - gt.spec.min_x) / r)) - 1);
+				const int y0 = std::max(0, int(std::floor((changed.min().y() - gt.spec.min_y) / r)) - 1);
+				const int x1 = std::min(gt.spec.nx() - 1, int(std::floor((changed.max().x() - gt.spec.min_x) / r)) + 1);
+				const int y1 = std::min(gt.spec.ny() - 1, int(std::floor((changed.max().y() - gt.spec.min_y) / r)) + 1);
+				if (x0 <= x1 && y0 <= y1) frameTruth->geometry(i, gt, x0, y0, x1, y1);
+			}
 			const double tsec = 1.7e9 + double(i) / sf.path.rate_hz;
 			const auto ts = mrpt::Clock::fromDouble(tsec);
 			const Pose3 robot = Pose3::fromXYZYPR(truth[i].x, truth[i].y, 0, truth[i].yaw, 0, 0);
@@ -243,6 +456,7 @@ int main(int argc, char** argv)
 			o->timestamp = ts;
 			o->odometry = mrpt::poses::CPose2D(odo[i].x, odo[i].y, odo[i].yaw);
 			ar << *o;
+			entry++;
 
 			// the walker rocks: the real Kinect pose may differ from the nominal one
 			Pose3 sway;
@@ -251,13 +465,43 @@ int main(int argc, char** argv)
 				const double dp = sf.kinect_sway * gauss(rngSway), dr = sf.kinect_sway * gauss(rngSway);
 				sway = Pose3::fromXYZYPR(0, 0, 0, 0, dp, dr);
 			}
-			const DepthFrame fr = kinect.render(sf.scene, robot * sf.kinect_pose * sway, rngKinect);
+			const DepthFrame fr = kinect.render(scene, robot * sf.kinect_pose * sway, rngKinect);
 			gt.markObserved(fr.footprint);
+			if (frameTruth)
+			{
+				frameTruth->see(gt, fr.footprint, 1);
+				frameTruth->seePoints(gt, kinect, fr, robot * sf.kinect_pose * sway);
+			}
 			size_t frameValid = 0;
 			auto k = toKinectObservation(sf.kinect, fr, kinPose, &frameValid);
+			k->sensorLabel = sf.kinect_label;
 			k->timestamp = ts;
 			validPix += frameValid;
 			ar << *k;
+			entry++;
+			for (size_t j = 0; j < moreKinects.size(); j++)
+			{
+				// each further camera: its own pose, label, rocking and noise stream
+				const ExtraKinect& e = sf.more_kinects[j];
+				Pose3 sw;
+				if (noise && e.sway > 0)
+				{
+					const double dp = e.sway * gauss(moreSwayRng[j]), dr = e.sway * gauss(moreSwayRng[j]);
+					sw = Pose3::fromXYZYPR(0, 0, 0, 0, dp, dr);
+				}
+				const DepthFrame fe = moreKinects[j].render(scene, robot * e.pose * sw, moreRng[j]);
+				gt.markObserved(fe.footprint);
+				if (frameTruth)
+				{
+					frameTruth->see(gt, fe.footprint, 1);
+					frameTruth->seePoints(gt, moreKinects[j], fe, robot * e.pose * sw);
+				}
+				auto ke = toKinectObservation(e.params, fe, toCPose3D(e.pose));
+				ke->sensorLabel = e.label;
+				ke->timestamp = ts;
+				ar << *ke;
+				entry++;
+			}
 			if (argDepthPgm.getValue())
 			{
 				char name[32];
@@ -275,7 +519,23 @@ int main(int argc, char** argv)
 
 			if (leddarOn)
 			{
-				const LeddarScan ls = leddar.scan(sf.scene, robot * sf.leddar_pose, rngLeddar);
+				const Pose3 ledWorld = robot * sf.leddar_pose;
+				const LeddarScan ls = leddar.scan(scene, ledWorld, rngLeddar);
+				if (frameTruth)
+				{
+					// the cells under the beams, up to the echo (or the range limit)
+					const double w = sf.leddar.hfov_deg / sf.leddar.segments * M_PI / 180.0;
+					for (int sgm = 0; sgm < sf.leddar.segments; sgm++)
+						for (int a = 0; a < sf.leddar.sub_h; a++)
+						{
+							const double h = sf.leddar.segmentAngle(sgm) - 0.5 * w + (a + 0.5) * w / sf.leddar.sub_h;
+							const Eigen::Vector3d dir = ledWorld.R * Eigen::Vector3d(std::cos(h), std::sin(h), 0);
+							const double len =
+								ls.valid[size_t(sgm)] ? double(ls.range[size_t(sgm)]) : sf.leddar.max_range;
+							const Eigen::Vector2d from = ledWorld.t.head<2>();
+							frameTruth->sweep(gt, from, from + len * dir.head<2>().normalized(), 2);
+						}
+				}
 				auto l = mrpt::obs::CObservation2DRangeScan::Create();
 				l->sensorLabel = "LEDDAR";
 				l->timestamp = ts;
@@ -292,6 +552,13 @@ int main(int argc, char** argv)
 					l->setScanRangeValidity(size_t(s), ls.valid[size_t(s)]);
 				}
 				ar << *l;
+				entry++;
+			}
+			if (frameTruth)
+			{
+				frameTruth->flush(i);
+				// numbered as ground-aware-mapper numbers them: the rawlog's first object is 1
+				frameTruth->entries(i, firstEntry + 1, entry);
 			}
 			char buf[256];
 			std::snprintf(
@@ -300,6 +567,7 @@ int main(int argc, char** argv)
 			pathCsv << buf;
 		}
 		fo.close();
+		if (frameTruth) frameTruth->close();
 		writeGroundTruth(prefix, sf, gt);
 		const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 		size_t nObs = 0, nDrop = 0, nFree = 0, nUnobs = 0;

@@ -9,6 +9,7 @@
 #include <map>
 #include <sstream>
 
+#include "Csv.h"
 #include "PathNames.h"
 #include "gam/common/Strings.h"
 
@@ -18,64 +19,11 @@ namespace
 {
 using gam::trim;
 
-double toDouble(const std::string& v, const std::string& what)
-{
-	try
-	{
-		size_t n = 0;
-		const double d = std::stod(v, &n);
-		if (trim(v.substr(n)).empty() && std::isfinite(d)) return d;
-	}
-	catch (...)
-	{
-	}
-	throw Error(what + ": '" + v + "' is not a number");
-}
-
-int toInt(const std::string& v, const std::string& what)
-{
-	const double d = toDouble(v, what);
-	if (d != std::floor(d) || std::abs(d) > 1e9) throw Error(what + ": '" + v + "' is not an integer");
-	return int(d);
-}
-
-using Columns = std::vector<std::string>;
-
-Columns splitCsv(const std::string& line)
-{
-	Columns out;
-	std::string cur;
-	for (char c : line)
-	{
-		if (c == ',')
-		{
-			out.push_back(cur);
-			cur.clear();
-		}
-		else if (c != '\r')
-			cur += c;
-	}
-	out.push_back(cur);
-	return out;
-}
-
-/** Reads the CSV file `path`: its first line must pass `headerOk` (else "bad header
- * (expected `expected`)"), then `onRow(columns, "PATH:LINE")` for every non-blank line. */
-template <class HeaderOk, class OnRow>
-void readCsv(const std::string& path, HeaderOk headerOk, const char* expected, OnRow onRow)
-{
-	std::ifstream f(path);
-	if (!f) throw Error("cannot open " + path);
-	std::string line;
-	if (!std::getline(f, line) || !headerOk(line)) throw Error(path + ": bad header (expected " + expected + ")");
-	int ln = 1;
-	while (std::getline(f, line))
-	{
-		ln++;
-		if (trim(line).empty()) continue;
-		onRow(splitCsv(line), path + ":" + std::to_string(ln));
-	}
-}
+using detail::Columns;
+using detail::readCsv;
+using detail::splitCsv;
+using detail::toDouble;
+using detail::toInt;
 
 /** yaml keys of a map_server file (flat "key: value" lines). */
 std::map<std::string, std::string> readYamlKeys(const std::string& path)

@@ -1,6 +1,7 @@
 // Ground-aware mapping for MRPT -- scene simulator: ground-truth 2D grid.
 #include "gam/sim/GroundTruth.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace gam::sim
@@ -101,31 +102,46 @@ void GroundTruthGrid::build(Scene& scene, const GridSpec& s)
 	geomLabel.assign(size_t(nx) * size_t(ny), Label::Free);
 	objectId.assign(geomLabel.size(), 0);
 	observed.assign(geomLabel.size(), 0);
-	const int k = std::max(1, s.subsamples);
 	for (int iy = 0; iy < ny; iy++)
-		for (int ix = 0; ix < nx; ix++)
+		for (int ix = 0; ix < nx; ix++) labelCell(scene, ix, iy);
+}
+
+void GroundTruthGrid::labelCell(const Scene& scene, int ix, int iy)
+{
+	const GridSpec& s = spec;
+	const int k = std::max(1, s.subsamples);
+	Label best = Label::Free;
+	int bestObj = 0;
+	bool first = true;
+	for (int a = 0; a < k; a++)
+		for (int b = 0; b < k; b++)
 		{
-			Label best = Label::Free;
-			int bestObj = 0;
-			bool first = true;
-			for (int a = 0; a < k; a++)
-				for (int b = 0; b < k; b++)
-				{
-					const double x = s.min_x + (ix + (a + 0.5) / k) * s.resolution;
-					const double y = s.min_y + (iy + (b + 0.5) / k) * s.resolution;
-					int obj;
-					const Label l = probe(scene, s, x, y, obj);
-					auto rank = [](Label q) { return q == Label::Obstacle ? 2 : (q == Label::Drop ? 1 : 0); };
-					if (first || rank(l) > rank(best) || (rank(l) == rank(best) && bestObj == 0 && obj != 0))
-					{
-						best = l;
-						bestObj = obj;
-						first = false;
-					}
-				}
-			geomLabel[idx(ix, iy)] = best;
-			objectId[idx(ix, iy)] = bestObj;
+			const double x = s.min_x + (ix + (a + 0.5) / k) * s.resolution;
+			const double y = s.min_y + (iy + (b + 0.5) / k) * s.resolution;
+			int obj;
+			const Label l = probe(scene, s, x, y, obj);
+			auto rank = [](Label q) { return q == Label::Obstacle ? 2 : (q == Label::Drop ? 1 : 0); };
+			if (first || rank(l) > rank(best) || (rank(l) == rank(best) && bestObj == 0 && obj != 0))
+			{
+				best = l;
+				bestObj = obj;
+				first = false;
+			}
 		}
+	geomLabel[idx(ix, iy)] = best;
+	objectId[idx(ix, iy)] = bestObj;
+}
+
+void GroundTruthGrid::relabel(const Scene& scene, const Eigen::AlignedBox2d& region)
+{
+	if (region.isEmpty()) return;
+	const int nx = spec.nx(), ny = spec.ny();
+	const int x0 = std::max(0, int(std::floor((region.min().x() - spec.min_x) / spec.resolution)) - 1);
+	const int y0 = std::max(0, int(std::floor((region.min().y() - spec.min_y) / spec.resolution)) - 1);
+	const int x1 = std::min(nx - 1, int(std::floor((region.max().x() - spec.min_x) / spec.resolution)) + 1);
+	const int y1 = std::min(ny - 1, int(std::floor((region.max().y() - spec.min_y) / spec.resolution)) + 1);
+	for (int iy = y0; iy <= y1; iy++)
+		for (int ix = x0; ix <= x1; ix++) labelCell(scene, ix, iy);
 }
 
 bool GroundTruthGrid::cellOf(double x, double y, int& ix, int& iy) const

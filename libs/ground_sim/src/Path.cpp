@@ -64,12 +64,18 @@ std::vector<Pose2> simulateOdometry(const std::vector<Pose2>& truth, const Odome
 	for (size_t i = 1; i < truth.size(); i++)
 	{
 		Pose2 d = truth[i].inverseCompose(truth[i - 1]);
-		if (n.enabled())
+		const double dist = std::hypot(d.x, d.y);
+		if (n.random())
 		{
-			const double dist = std::hypot(d.x, d.y);
 			d.x += n.xy_per_m * dist * g(rng);
 			d.y += n.xy_per_m * dist * g(rng);
 			d.yaw += (n.yaw_per_m * dist + n.yaw_per_rad * std::abs(d.yaw)) * g(rng);
+		}
+		if (n.scale != 0 || n.yaw_bias_per_m != 0)
+		{
+			d.x *= 1 + n.scale;
+			d.y *= 1 + n.scale;
+			d.yaw += n.yaw_bias_per_m * dist;
 		}
 		odo.push_back(odo.back().compose(d));
 	}

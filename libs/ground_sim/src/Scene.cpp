@@ -431,4 +431,70 @@ Eigen::AlignedBox3d Scene::bounds() const
 	return b;
 }
 
+bool Scene::dynamic() const
+{
+	for (const auto& o : objects)
+		if (o.dynamic()) return true;
+	return false;
+}
+
+Scene Scene::atFrame(int frame) const
+{
+	Scene s;
+	s.has_floor = has_floor;
+	s.objects = objects;
+	if (!dynamic())
+	{
+		s.holes = holes;
+		s.solids = solids;
+		s.floor_patches = floor_patches;
+		return s;
+	}
+	// per object id: present? offset?
+	auto state = [&](int id, Eigen::Vector2d& off) {
+		const ObjectInfo* o = object(id);
+		off = o ? o->offsetAt(frame) : Eigen::Vector2d::Zero();
+		return !o || o->presentAt(frame);
+	};
+	Eigen::Vector2d off;
+	for (const auto& h : holes)
+		if (state(h.object_id, off))
+		{
+			Hole c = h;
+			c.cx += off.x();
+			c.cy += off.y();
+			s.holes.push_back(c);
+		}
+	for (const auto& p : floor_patches)
+		if (state(p.object_id, off))
+		{
+			FloorPatch c = p;
+			c.cx += off.x();
+			c.cy += off.y();
+			s.floor_patches.push_back(c);
+		}
+	for (const auto& so : solids)
+		if (state(so.object_id, off))
+		{
+			ConvexSolid c = so;
+			const Eigen::Vector3d t(off.x(), off.y(), 0);
+			for (size_t i = 0; i < c.n.size(); i++) c.d[i] += c.n[i].dot(t);  // n.(p - t) <= d
+			c.bbox.translate(t);
+			s.solids.push_back(c);
+		}
+	return s;
+}
+
+Eigen::AlignedBox2d Scene::footprintAt(int id, int frame) const
+{
+	Eigen::AlignedBox2d b;
+	b.setEmpty();
+	const ObjectInfo* o = object(id);
+	if (!o || !o->presentAt(frame) || o->bbox.isEmpty()) return b;
+	const Eigen::Vector2d off = o->offsetAt(frame);
+	b.extend(o->bbox.min().head<2>() + off);
+	b.extend(o->bbox.max().head<2>() + off);
+	return b;
+}
+
 }  // namespace gam::sim

@@ -2,6 +2,7 @@
 #include "gam/sim/SceneFile.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -127,7 +128,47 @@ struct SceneBuilder
 	SceneFile sf;
 	std::set<int> ids;  ///< object ids used so far
 	bool havePath = false;
+	std::set<std::string> kinectLabels;
 };
+
+/** "A-B" (frames A to B, inclusive) or "A-" (from A on); 0-based frame numbers. */
+void frameRange(Args& a, const std::string& k, int& first, int& last)
+{
+	const std::string v = a.str(k);
+	const auto dash = v.find('-');
+	if (dash == std::string::npos || dash == 0) a.fail(k + "= wants A-B or A- (frame numbers, got '" + v + "')");
+	const double f0 = a.toNum(k, v.substr(0, dash));
+	const double f1 = dash + 1 < v.size() ? a.toNum(k, v.substr(dash + 1)) : 1e9;
+	if (f0 < 0 || f0 != std::floor(f0) || f1 != std::floor(f1) || f1 < f0 || f1 > 1e9)
+		a.fail(k + "= wants whole frame numbers 0 <= A <= B (got '" + v + "')");
+	first = int(f0);
+	last = f1 >= 1e9 ? std::numeric_limits<int>::max() : int(f1);
+}
+
+/** frames=A-B (present only then), move=dx,dy (per frame) or to=x,y (where x=,y= end
+ * up), moving=A-B (when it moves; default the frames= range). Issue #14. */
+void parseMotion(Args& a, ObjectInfo& oi)
+{
+	if (a.has("frames")) frameRange(a, "frames", oi.first_frame, oi.last_frame);
+	if (a.has("moving") && !a.has("move") && !a.has("to")) a.fail("moving= needs move= or to=");
+	if (!a.has("move") && !a.has("to")) return;
+	if (a.has("move") && a.has("to")) a.fail("give move= or to=, not both");
+	oi.move_first = oi.first_frame;
+	oi.move_last = oi.last_frame;
+	if (a.has("moving")) frameRange(a, "moving", oi.move_first, oi.move_last);
+	if (a.has("move"))
+	{
+		const std::vector<double> m = a.list("move", 2);
+		oi.move_per_frame = Eigen::Vector2d(m[0], m[1]);
+		return;
+	}
+	if (!a.has("x") || !a.has("y")) a.fail("to= needs the object's x= and y= (use move=dx,dy per frame)");
+	if (oi.move_last == std::numeric_limits<int>::max() || oi.move_last == oi.move_first)
+		a.fail("to= needs a closed range of at least two frames in moving= or frames= (A-B, B > A)");
+	const std::vector<double> t = a.list("to", 2);
+	oi.move_per_frame =
+		(Eigen::Vector2d(t[0], t[1]) - Eigen::Vector2d(a.req("x"), a.req("y"))) / double(oi.move_last - oi.move_first);
+}
 
 /** The keys every object takes (id=, name=, category=); adds the object to the scene. */
 ObjectInfo& beginObject(SceneBuilder& b, Args& a, const std::string& type)
@@ -154,6 +195,7 @@ ObjectInfo& beginObject(SceneBuilder& b, Args& a, const std::string& type)
 	oi.dropout = a.num("dropout", oi.material == Material::Specular ? 0.5 : 0.0);
 	if (!(oi.dropout >= 0 && oi.dropout <= 1)) a.fail("dropout must be in [0,1]");
 	if (oi.dropout > 0 && oi.material != Material::Specular) a.fail("dropout= needs material=specular");
+	parseMotion(a, oi);
 	b.sf.scene.objects.push_back(oi);
 	return b.sf.scene.objects.back();
 }
@@ -186,8 +228,21 @@ void parseFloor(SceneBuilder& b, Args& a) { b.sf.scene.has_floor = a.num("presen
 void parseKinect(SceneBuilder& b, Args& a)
 {
 	SceneFile& sf = b.sf;
-	sf.kinect_pose = poseOf(a.list("pose", 6));
-	auto& k = sf.kinect;
+	const std::string label = a.str("label", "KINECT");
+	for (char c : label)
+		if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-')
+			a.fail("label must be letters, digits, _ or - (got '" + label + "')");
+	if (b.kinectLabels.count(label)) a.fail("duplicate camera label '" + label + "'");
+	b.kinectLabels.insert(label);
+	// The first kinect statement sets the main camera (kinect, kinect_pose); each
+	// further one adds a camera to more_kinects.
+	const bool first = b.kinectLabels.size() == 1;
+	ExtraKinect extra;
+	if (first) sf.kinect_label = label;
+	extra.label = label;
+	Pose3& pose = first ? sf.kinect_pose : extra.pose;
+	pose = poseOf(a.list("pose", 6));
+	auto& k = first ? sf.kinect : extra.params;
 	k.noise_scale = a.num("noise_scale", k.noise_scale);
 	if (k.noise_scale < 0) a.fail("noise_scale must be >= 0");
 	k.min_range = a.pos("min_range", k.min_range);
@@ -200,8 +255,10 @@ void parseKinect(SceneBuilder& b, Args& a)
 	k.grazing_start_deg = a.num("grazing_start", k.grazing_start_deg);
 	k.grazing_end_deg = a.num("grazing_end", k.grazing_end_deg);
 	if (!(k.grazing_end_deg > k.grazing_start_deg)) a.fail("grazing_end must be > grazing_start");
-	sf.kinect_sway = a.num("sway", 0) * kDeg;
-	if (sf.kinect_sway < 0 || sf.kinect_sway > 10 * kDeg) a.fail("sway must be in [0,10] degrees");
+	double& sway = first ? sf.kinect_sway : extra.sway;
+	sway = a.num("sway", 0) * kDeg;
+	if (sway < 0 || sway > 10 * kDeg) a.fail("sway must be in [0,10] degrees");
+	if (!first) sf.more_kinects.push_back(extra);
 }
 
 void parseLeddar(SceneBuilder& b, Args& a)
@@ -457,6 +514,10 @@ void parseOdometryNoise(SceneBuilder& b, Args& a)
 	o.yaw_per_m = a.num("yaw", 0) * kDeg;
 	o.yaw_per_rad = a.num("turn", 0);
 	if (o.xy_per_m < 0 || o.yaw_per_m < 0 || o.yaw_per_rad < 0) a.fail("noise must be >= 0");
+	o.scale = a.num("scale", 0);
+	if (std::abs(o.scale) >= 0.5) a.fail("scale must be in (-0.5, 0.5)");
+	o.yaw_bias_per_m = a.num("yaw_bias", 0) * kDeg;
+	if (std::abs(o.yaw_bias_per_m) > 90 * kDeg) a.fail("yaw_bias must be in [-90, 90] degrees per metre");
 }
 
 void parseGrid(SceneBuilder& b, Args& a)
@@ -478,6 +539,7 @@ void parseGrid(SceneBuilder& b, Args& a)
 	const double ss = a.num("subsamples", g.subsamples);
 	if (ss < 1 || ss > 9 || ss != std::floor(ss)) a.fail("subsamples must be an integer in 1..9");
 	g.subsamples = int(ss);
+	if (a.has("per_frame")) b.sf.per_frame_truth = a.num("per_frame", 0) != 0 ? 1 : 0;
 	b.sf.has_grid = true;
 }
 

@@ -8,9 +8,12 @@
 //  * MapReaders.h: reading the map_server map and the ground truth (loadRosMap,
 //    loadGroundTruth, Error);
 //  * Scoring.h: the scoring rules (resample, classify, evaluate and the scores);
-//  * Reports.h: the reports (formatTable, toJson, toCsv).
+//  * Reports.h: the reports (formatTable, toJson, toCsv);
+//  * Sequence.h: the maps after every frame against the per-frame ground truth
+//    (ghost cells, time to clear, hazards out of view, changes outside the view).
 #pragma once
 
 #include "gam/eval/MapReaders.h"
 #include "gam/eval/Reports.h"
 #include "gam/eval/Scoring.h"
+#include "gam/eval/Sequence.h"

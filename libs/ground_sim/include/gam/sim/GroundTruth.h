@@ -64,6 +64,9 @@ class GroundTruthGrid
 	/** Computes the geometric labels and sets the object categories in
 	 * `scene.objects` (unless given in the scene). */
 	void build(Scene& scene, const GridSpec& s);
+	/** Labels the cells of `region` (xy, plus one cell around it) again from `scene`
+	 * (e.g. Scene::atFrame(f) after an object moved; build() must have run). */
+	void relabel(const Scene& scene, const Eigen::AlignedBox2d& region);
 	/** Marks the cells containing the given world points as observed. */
 	void markObserved(const std::vector<Eigen::Vector2d>& pts);
 	/** Final label (unobserved where never seen). */
@@ -73,6 +76,8 @@ class GroundTruthGrid
 	bool cellOf(double x, double y, int& ix, int& iy) const;
 	size_t idx(int ix, int iy) const { return size_t(iy) * size_t(spec.nx()) + size_t(ix); }
 
+	/** Labels one cell from its subsamples x subsamples probes (the worst wins). */
+	void labelCell(const Scene& scene, int ix, int iy);
 	/** Geometric probe at one point: label and object id. */
 	static Label probe(const Scene& scene, const GridSpec& s, double x, double y, int& obj);
 };

@@ -33,13 +33,17 @@ std::vector<Pose2> samplePath(const PathSpec& spec);
 
 /** Odometry error model: each increment between frames gets Gaussian noise
  * with sigma_xy = xy_per_m * dist (both axes), sigma_yaw = yaw_per_m * dist +
- * yaw_per_rad * |dyaw|. */
+ * yaw_per_rad * |dyaw|, and a systematic drift: its translation is scaled by
+ * (1 + scale) and yaw_bias_per_m * dist is added to its rotation. */
 struct OdometryNoise
 {
 	double xy_per_m = 0.0;
 	double yaw_per_m = 0.0;  ///< radians per metre
 	double yaw_per_rad = 0.0;
-	bool enabled() const { return xy_per_m > 0 || yaw_per_m > 0 || yaw_per_rad > 0; }
+	double scale = 0.0;           ///< systematic: every increment's translation times (1 + scale)
+	double yaw_bias_per_m = 0.0;  ///< systematic: radians added per metre travelled
+	bool random() const { return xy_per_m > 0 || yaw_per_m > 0 || yaw_per_rad > 0; }
+	bool enabled() const { return random() || scale != 0 || yaw_bias_per_m != 0; }
 };
 
 /** The absolute odometry readings for the true path (starts at truth[0]). */

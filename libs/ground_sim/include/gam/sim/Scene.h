@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <limits>
 #include <string>
 #include <vector>
@@ -127,9 +128,28 @@ struct ObjectInfo
 	bool category_given = false;  ///< set explicitly in the scene file
 	bool traversable = false;     ///< ramps within the slope limit (set by GroundTruthGrid::build)
 	Material material = Material::Normal;
-	double dropout = 0;    ///< Specular: per-pixel dropout probability
-	double slope_deg = 0;  ///< ramps: surface slope
-	Eigen::AlignedBox3d bbox;
+	double dropout = 0;        ///< Specular: per-pixel dropout probability
+	double slope_deg = 0;      ///< ramps: surface slope
+	Eigen::AlignedBox3d bbox;  ///< at the object's first placement (frame first_frame)
+
+	// Motion over the frames (issue #14): present in frames first_frame..last_frame
+	// (0-based, inclusive); moved by move_per_frame per frame in move_first..move_last
+	// (held before and after). A static object has the defaults.
+	int first_frame = 0;
+	int last_frame = std::numeric_limits<int>::max();
+	int move_first = 0, move_last = 0;
+	Eigen::Vector2d move_per_frame = Eigen::Vector2d::Zero();
+	bool dynamic() const
+	{
+		return first_frame > 0 || last_frame != std::numeric_limits<int>::max() || !move_per_frame.isZero(0);
+	}
+	bool presentAt(int frame) const { return frame >= first_frame && frame <= last_frame; }
+	/** Translation (x, y) of the object at `frame` from its placement in the scene file. */
+	Eigen::Vector2d offsetAt(int frame) const
+	{
+		const int f = std::clamp(frame, move_first, std::max(move_first, move_last));
+		return move_per_frame * double(f - move_first);
+	}
 };
 
 /** A patch of floor with its own material (a black mat, a shiny tile):
@@ -175,6 +195,15 @@ class Scene
 	Material materialOf(int id) const;
 	/** Bounding box of all the solids and holes (the floor is unbounded). */
 	Eigen::AlignedBox3d bounds() const;
+
+	/** Does any object appear, disappear or move over the frames? */
+	bool dynamic() const;
+	/** The scene as it is in frame `frame`: the parts of absent objects removed, those
+	 * of moving objects translated (ObjectInfo::presentAt, offsetAt). `objects` is kept
+	 * whole. A static scene gives a copy of itself. */
+	Scene atFrame(int frame) const;
+	/** xy bounds of object `id`'s parts as placed in `frame` (empty if absent then). */
+	Eigen::AlignedBox2d footprintAt(int id, int frame) const;
 
    private:
 	/** Floor+pits only. */

@@ -5,10 +5,14 @@
 // a value; lists are comma separated). Lengths in metres, ALL ANGLES IN
 // DEGREES. World frame: +X forward, +Y left, +Z up, floor at z = 0.
 // Every object needs a unique integer id >= 1; name= and category= (negative,
-// small, overhang, large, ramp) are optional on every object.
+// small, overhang, large, ramp) are optional on every object, and so is motion
+// (issue #14): frames=A-B (present only in frames A..B, 0-based; "A-" = from A on),
+// move=dx,dy (metres per frame) or to=x,y (where the object's x=,y= ends up),
+// moving=A-B (when it moves; default the frames= range).
 //
 //   floor present=1                      # present=0: no floor at all
 //   kinect pose=x,y,z,yaw,pitch,roll     # on the robot; pitch>0 looks down
+//          [label=KINECT]   # several kinect statements = several cameras, unique labels
 //          [noise_scale=1] [min_range=0.5] [max_range=4.5] [spike_prob=1e-4]
 //          [flying_prob=0.5] [grazing_start=70] [grazing_end=85] [sway=0]
 //        # sway: sigma [deg] of a random pitch and roll of the real sensor per
@@ -33,11 +37,13 @@
 //        # two side panels + `boards` boards from `bottom` up to sz
 //   path waypoints=x,y,yaw;x,y,yaw;... [spacing=0.10] [turn_spacing=5] [frames=0] [rate=10]
 //        # one waypoint: `frames` frames taken there (default 1)
-//   odometry_noise [xy=0] [yaw=0] [turn=0]
-//        # per increment: sigma_xy = xy*dist, sigma_yaw = yaw(deg/m)*dist + turn*|dyaw|
+//   odometry_noise [xy=0] [yaw=0] [turn=0] [scale=0] [yaw_bias=0]
+//        # per increment: sigma_xy = xy*dist, sigma_yaw = yaw(deg/m)*dist + turn*|dyaw|;
+//        # systematic drift: the distance times (1+scale), yaw_bias (deg/m) * dist added
 //   grid resolution=0.05 min_x= max_x= min_y= max_y= [robot_height=1.9]
 //        [obstacle_min=0.02] [drop_min=0.02] [small_max=0.20] [overhang_clearance=0.10]
-//        [max_slope=10] [subsamples=3]
+//        [max_slope=10] [subsamples=3] [per_frame=auto]
+//        # per_frame=1: also the per-frame ground truth (default: when something moves)
 //
 // Errors throw SceneError with "file:line: message".
 #pragma once
@@ -59,6 +65,15 @@ class SceneError : public std::runtime_error
 	using std::runtime_error::runtime_error;
 };
 
+/** A further depth camera on the robot (a second `kinect` statement). */
+struct ExtraKinect
+{
+	std::string label;
+	KinectParams params;
+	Pose3 pose;
+	double sway = 0;
+};
+
 struct SceneFile
 {
 	Scene scene;
@@ -67,7 +82,12 @@ struct SceneFile
 	LeddarParams leddar;
 	Pose3 leddar_pose = Pose3::fromXYZYPR(0.20, 0, 0.30, 0, 0, 0);
 	bool leddar_enabled = true;
-	double kinect_sway = 0;  ///< radians, sigma of the per-frame pitch/roll perturbation
+	double kinect_sway = 0;                 ///< radians, sigma of the per-frame pitch/roll perturbation
+	std::string kinect_label = "KINECT";    ///< sensorLabel of the main camera
+	std::vector<ExtraKinect> more_kinects;  ///< the second, third... kinect statements
+	/** Write the per-frame ground truth (PREFIX_gt_frames.csv): 1 yes, 0 no, -1 = only
+	 * if an object appears, disappears or moves (grid per_frame=). */
+	int per_frame_truth = -1;
 	PathSpec path;
 	OdometryNoise odometry_noise;
 	GridSpec grid;
