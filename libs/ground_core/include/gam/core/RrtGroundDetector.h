@@ -68,9 +68,10 @@ struct RrtGpdParams
 	 * against the parent's local plane, max_fit_rms, N_th), until the surface
 	 * meets the ground plane again or the tree has K + 1 nodes. The random
 	 * tree puts a node every ~d_n and reaches a narrow ramp only through its
-	 * foot: a 0.7 m wide 8 deg ramp got 0-5 nodes in most frames, too few (and
-	 * too collinear) for a patch of its own; filled, its nodes tile it with
-	 * their own fit windows. Not in the paper variant. */
+	 * foot: a 0.7 m wide 8 deg ramp got a handful of nodes near its foot in
+	 * 4 of 11 frames, too few (and too collinear) for a patch of its own;
+	 * filled, its nodes tile it with their own fit windows. Not in the paper
+	 * variant. */
 	bool fill_patches = true;
 	uint32_t random_seed = 1;
 
