@@ -530,8 +530,10 @@ int main(int argc, char** argv)
 						{
 							const double h = sf.leddar.segmentAngle(sgm) - 0.5 * w + (a + 0.5) * w / sf.leddar.sub_h;
 							const Eigen::Vector3d dir = ledWorld.R * Eigen::Vector3d(std::cos(h), std::sin(h), 0);
-							const double len =
-								ls.valid[size_t(sgm)] ? double(ls.range[size_t(sgm)]) : sf.leddar.max_range;
+							// up to the echo and 3 sigma beyond it (where its noisy range may put it)
+							const double len = ls.valid[size_t(sgm)]
+												   ? double(ls.range[size_t(sgm)]) + 3 * sf.leddar.sigma
+												   : sf.leddar.max_range;
 							const Eigen::Vector2d from = ledWorld.t.head<2>();
 							frameTruth->sweep(gt, from, from + len * dir.head<2>().normalized(), 2);
 						}
