@@ -285,8 +285,11 @@ SequenceScore evaluateSequence(
 				hazMarked[i] = 0;
 			else
 			{
-				if (inView && occupied) hazMarked[i] = 1;
-				if (hazMarked[i] && !(mask[i] & ViewNear) && inside[i])
+				// what the map had when it last saw the cell (or a cell next to it: the
+				// margin) is what it must keep out of view
+				const bool nearView = mask[i] & ViewNear;
+				if (nearView) hazMarked[i] = occupied;
+				if (hazMarked[i] && !nearView && inside[i])
 				{
 					fs.hazard_out_of_view++;
 					hazOut[i] = 1;
@@ -390,7 +393,9 @@ std::string sequenceToJson(const std::vector<SequenceScore>& s, const SequenceOp
 		  << ", \"hazard_cells\": " << m.hazard_cells << ", \"hazard_lost\": " << m.hazard_lost
 		  << ", \"changed_outside_view\": " << m.changed_outside_view
 		  << ", \"changed_outside_cells\": " << m.changed_outside_cells
-		  << ", \"value_changed_outside_view\": " << m.value_changed_outside_view << ",\n     \"per_frame\": [";
+		  << ", \"value_changed_outside_view\": " << m.value_changed_outside_view << ",\n     \"clear_frames\": [";
+		for (size_t c = 0; c < m.clear_frames.size(); c++) o << (c ? ", " : "") << m.clear_frames[c];
+		o << "],\n     \"per_frame\": [";
 		for (size_t f = 0; f < m.perFrame.size(); f++)
 		{
 			const auto& p = m.perFrame[f];

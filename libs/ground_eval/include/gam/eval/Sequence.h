@@ -19,10 +19,12 @@
 //    s. Ghost = still occupied after frame s + ghost_frames (cells with s +
 //    ghost_frames beyond the last frame are not judged; a cell seen as obstacle
 //    again before being cleared is dropped).
-//  * Hazard cell: GT drop cell seen and occupied in the map in some frame. In every
-//    later frame in which it is still GT drop, out of view (farther than
-//    view_margin_cells from the footprint) and inside the map's extent, it must be
-//    occupied; a cell that is not, in any such frame, is lost.
+//  * Hazard cell: GT drop cell occupied in the map after the last frame in which it
+//    was in view (seen, or within view_margin_cells of the footprint). In every later
+//    frame in which it is still GT drop, out of view (farther than view_margin_cells
+//    from the footprint) and inside the map's extent, it must stay occupied; a cell
+//    that is not, in any such frame, is lost (changes while it is in view are the
+//    detection's business, not this rule's).
 //  * Changed outside the view: the map state (occupied / free / unknown) of a cell
 //    differs from the one after the previous frame (frame 0: from unknown), the cell
 //    is inside both maps' extents and farther than view_margin_cells from the
@@ -111,7 +113,7 @@ struct SequenceScore
 	long ghost_cells = 0;            ///< of the judged: still occupied ghost_frames frames after seen free
 	std::vector<int> clear_frames;   ///< per cleared cell: frames from seen free to not occupied
 	long not_cleared = 0;            ///< never cleared until the last frame
-	long hazard_cells = 0;           ///< hazard cells that were out of view in some frame
+	long hazard_cells = 0;           ///< hazard cells (occupied when last seen) out of view in some frame
 	long hazard_lost = 0;            ///< of them: not occupied in such a frame
 	long changed_outside_view = 0;   ///< cell-frame events
 	long changed_outside_cells = 0;  ///< distinct cells
