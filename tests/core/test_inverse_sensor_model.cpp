@@ -264,6 +264,40 @@ TEST(InverseSensorModel, ClassifyByTheMeanOfNSamples)
 	EXPECT_EQ(ism.classify(cellOfN(9, -0.04f), 1, 1, kFloor, band, d), VoxelClass::Ground);
 }
 
+TEST(InverseSensorModel, ClassifyByTheMeanAgainstTheMeasuredFloorSpread)
+{
+	// Issue #13: with measure_floor_offset the fixed d_pth of the band of the
+	// mean is replaced by tau, the measured spread of the floor cells' means
+	// around the plane: band of the mean = k sqrt(tau^2 + sigma^2 / N), never
+	// wider than d_pth + (b - d_pth) / sqrt(N) and never narrower than
+	// traversable_step (2 cm). One-sample band b = 0.06 = d_pth 0.03 + 3 sigma
+	// with sigma = 0.01; k = noise_sigmas = 3.
+	InverseSensorModel ism;
+	const double band = 0.06;
+	double d = 0;
+	auto cellOfN = [](int n, float z) {
+		ElevationCell c;
+		for (int i = 0; i < n; i++) c.add(z);
+		return c;
+	};
+	// 16 samples 2.5 cm below the plane (a far pit's bottom). d_pth form:
+	// 0.03 + 0.03 / 4 = 0.0375 > 0.025: floor. Flat floor, tau = 2 mm:
+	// 3 sqrt(0.002^2 + 0.01^2 / 16) = 3 sqrt(4e-6 + 6.25e-6) = 3 * 0.0032016 =
+	// 0.0096, raised to the 2 cm step: 0.02 < 0.025: a drop.
+	EXPECT_EQ(ism.classify(cellOfN(16, -0.025f), 1, 1, kFloor, band, d), VoxelClass::Ground);
+	EXPECT_EQ(ism.classify(cellOfN(16, -0.025f), 1, 1, kFloor, band, d, 0.002), VoxelClass::Drop);
+	EXPECT_EQ(ism.classify(cellOfN(16, 0.025f), 1, 1, kFloor, band, d, 0.002), VoxelClass::Obstacle);
+	// A 1.5 cm mat is beyond the measured 9.6 mm but below the 2 cm step: floor.
+	EXPECT_EQ(ism.classify(cellOfN(16, 0.015f), 1, 1, kFloor, band, d, 0.002), VoxelClass::Ground);
+	// A rough floor, tau = 2 cm: 3 sqrt(4e-4 + 6.25e-6) = 0.0605, capped at the
+	// d_pth form 0.0375 > 0.025: floor.
+	EXPECT_EQ(ism.classify(cellOfN(16, -0.025f), 1, 1, kFloor, band, d, 0.02), VoxelClass::Ground);
+	// One sample: only the one-sample band counts, whatever tau.
+	EXPECT_EQ(ism.classify(cellOfN(1, -0.025f), 1, 1, kFloor, band, d, 0.0), VoxelClass::Ground);
+	// Nothing measured yet (no compute()): -1, the d_pth form.
+	EXPECT_EQ(ism.floorOffset(Eigen::Vector3d(0, 0, 1), 3, 0, 0), -1.0);
+}
+
 namespace
 {
 // Frame of test ISM-1 (grid -5..5 m, 5 cm). Sensor at (0, 0, 1), ground z = 0.

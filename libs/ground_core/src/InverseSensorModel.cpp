@@ -67,6 +67,8 @@ void InverseSensorModel::measureFloorNoise(
 	const GridGeometry& g = frame.geometry();
 	const size_t nb = size_t(std::ceil((m_maxRange + 1.0) / m_params.floor_noise_bin));
 	m_floorNoise.assign(nb, -1.f);
+	m_floorOffset.assign(nb, -1.f);
+	m_offsetValue.clear();
 	if (!m_params.measure_floor_noise || m_params.noise_sigmas <= 0) return;
 	m_noiseBin.clear();
 	m_noiseValue.clear();
@@ -85,6 +87,7 @@ void InverseSensorModel::measureFloorNoise(
 		{
 			m_noiseBin.push_back(uint32_t(bin));
 			m_noiseValue.push_back(std::sqrt(c.variance()));
+			m_offsetValue.push_back(float(std::abs(pl.signedDistance(x, y, c.mean()))));
 		}
 	}
 	// Group the samples by bin (stable counting sort), then the median of each.
@@ -92,7 +95,13 @@ void InverseSensorModel::measureFloorNoise(
 	for (uint32_t b : m_noiseBin) m_noiseBinStart[b + 1]++;
 	for (size_t b = 0; b < nb; b++) m_noiseBinStart[b + 1] += m_noiseBinStart[b];
 	m_noiseSorted.resize(m_noiseValue.size());
-	for (size_t i = 0; i < m_noiseBin.size(); i++) m_noiseSorted[m_noiseBinStart[m_noiseBin[i]]++] = m_noiseValue[i];
+	m_offsetSorted.resize(m_offsetValue.size());
+	for (size_t i = 0; i < m_noiseBin.size(); i++)
+	{
+		const uint32_t at = m_noiseBinStart[m_noiseBin[i]]++;
+		m_noiseSorted[at] = m_noiseValue[i];
+		m_offsetSorted[at] = m_offsetValue[i];
+	}
 	// m_noiseBinStart[b] is now the end of bin b (= the start of bin b + 1).
 	for (size_t b = 0; b < nb; b++)
 	{
@@ -102,11 +111,24 @@ void InverseSensorModel::measureFloorNoise(
 		float* v = m_noiseSorted.data() + begin;
 		std::nth_element(v, v + long(n / 2), v + n);
 		m_floorNoise[b] = v[n / 2];
+		// The cells' means around the plane: 1.4826 x the median |distance| is
+		// their std for a normal spread (robust to the odd bump among them).
+		float* o = m_offsetSorted.data() + begin;
+		std::nth_element(o, o + long(n / 2), o + n);
+		m_floorOffset[b] = 1.4826f * o[n / 2];
 	}
 }
 
+double InverseSensorModel::floorOffset(const Eigen::Vector3d& sensor, double x, double y, double z) const
+{
+	if (!m_params.measure_floor_offset) return -1;
+	const double dx = x - sensor.x(), dy = y - sensor.y(), dz = z - sensor.z();
+	const size_t bin = size_t(std::sqrt(dx * dx + dy * dy + dz * dz) / m_params.floor_noise_bin);
+	return bin < m_floorOffset.size() ? double(m_floorOffset[bin]) : -1;
+}
+
 VoxelClass InverseSensorModel::classify(
-	const ElevationCell& c, double x, double y, const Plane& pl, double band, double& dMean) const
+	const ElevationCell& c, double x, double y, const Plane& pl, double band, double& dMean, double floorOffset) const
 {
 	const double dTop = pl.signedDistance(x, y, c.z_max);
 	const double dBot = pl.signedDistance(x, y, c.z_min);
@@ -122,7 +144,16 @@ VoxelClass InverseSensorModel::classify(
 	// d_pth part (plane error, floor unevenness) does not.
 	if (m_params.mean_test && c.count > 1 && th > m_params.d_pth)
 	{
-		const double meanBand = m_params.d_pth + (th - m_params.d_pth) / std::sqrt(double(c.count));
+		double meanBand = m_params.d_pth + (th - m_params.d_pth) / std::sqrt(double(c.count));
+		if (floorOffset >= 0 && m_params.noise_sigmas > 0)
+		{
+			// Both parts measured on this frame's floor: sigma (one sample) from
+			// the band, tau (a cell's mean) from the floor cells. Never wider
+			// than the d_pth form (a floor too rough to measure keeps that).
+			const double k = m_params.noise_sigmas, sigma = (th - m_params.d_pth) / k;
+			const double measured = k * std::sqrt(floorOffset * floorOffset + sigma * sigma / double(c.count));
+			meanBand = std::min(meanBand, std::max(measured, m_params.traversable_step));
+		}
 		if (dMean > meanBand) return VoxelClass::Obstacle;
 		if (dMean < -meanBand) return VoxelClass::Drop;
 	}
@@ -242,7 +273,8 @@ void InverseSensorModel::compute(
 			const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
 			const Plane& pl = choosePlane(det, c, x, y, block);
 			const double hs = pl.signedDistance(sensor.x(), sensor.y(), sensor.z());
-			cls = classify(c, x, y, pl, groundBand(sensor, hs, x, y, c.mean()), dMean);
+			cls = classify(
+				c, x, y, pl, groundBand(sensor, hs, x, y, c.mean()), dMean, floorOffset(sensor, x, y, c.mean()));
 		}
 		m_class[idx] = cls;
 		m_classCells.push_back(idx);

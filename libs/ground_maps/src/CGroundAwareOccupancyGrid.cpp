@@ -359,17 +359,20 @@ void CGroundAwareOccupancyGrid::syncMissingLayer() const
 		L.getYMin() == getYMin() && L.getResolution() == getResolution())
 		return;
 	// Same lattice as this grid (MRPT keeps the alignment when a grid grows or
-	// is recentred): copy the cells both cover.
-	COccupancyGridMap2D fresh(getXMin(), getXMax(), getYMin(), getYMax(), getResolution());
-	if (L.getSizeX() && L.getSizeY())
-		for (unsigned cy = 0; cy < L.getSizeY(); cy++)
-			for (unsigned cx = 0; cx < L.getSizeX(); cx++)
-			{
-				const int nx = fresh.x2idx(L.idx2x(cx)), ny = fresh.y2idx(L.idx2y(cy));
-				if (nx < 0 || ny < 0 || nx >= int(fresh.getSizeX()) || ny >= int(fresh.getSizeY())) continue;
-				fresh.getRow(ny)[nx] = L.getRow(int(cy))[cx];
-			}
-	L = std::move(fresh);
+	// is recentred): keep the cells both cover. (Resized in place: assigning
+	// whole COccupancyGridMap2D objects is avoided.)
+	const unsigned osx = L.getSizeX(), osy = L.getSizeY();
+	const float ox = L.getXMin(), oy = L.getYMin(), ores = L.getResolution();
+	const std::vector<cellType> old = L.getRawMap();
+	L.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
+	if (ores != getResolution()) return;
+	for (unsigned cy = 0; cy < osy; cy++)
+		for (unsigned cx = 0; cx < osx; cx++)
+		{
+			const int nx = L.x2idx(ox + (cx + 0.5f) * ores), ny = L.y2idx(oy + (cy + 0.5f) * ores);
+			if (nx < 0 || ny < 0 || nx >= int(L.getSizeX()) || ny >= int(L.getSizeY())) continue;
+			L.getRow(ny)[nx] = old[size_t(cy) * osx + cx];
+		}
 }
 
 namespace
@@ -537,7 +540,7 @@ void CGroundAwareOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in,
 			TGroundAwareOptions o;
 			gam::maps::ini::read(o, in, "CGroundAwareOccupancyGrid");
 			setGroundOptions(o);
-			m_missingLayer = COccupancyGridMap2D(getXMin(), getXMax(), getYMin(), getYMax(), getResolution());
+			m_missingLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
 			if (version >= 1) in >> m_missingLayer;
 			syncMissingLayer();
 		}

@@ -53,6 +53,20 @@ struct IsmParams
 	 * is ~8 mm) but its 20 samples put the mean far outside the band of the
 	 * mean (issue #17). Off = only z_min / z_max against the one-sample band. */
 	bool mean_test = true;
+	/** The mean test's fixed part d_pth (plane error, floor unevenness) taken
+	 * from the floor itself too: per range bin, tau = the robust spread of the
+	 * floor cells' means around the plane (1.4826 x their median |distance|),
+	 * and the band of the mean of N samples is noise_sigmas * sqrt(tau^2 +
+	 * sigma^2 / N). A flat floor seen by a good camera then lets a 3 cm
+	 * depression 3.5 m away count, where d_pth alone would not (issue #13);
+	 * never narrower than traversable_step;
+	 * an uneven floor or a poor plane fit widens it by itself, up to the
+	 * d_pth form (never wider). Off: d_pth. */
+	bool measure_floor_offset = true;
+	/** Bumps and dips smaller than this are floor for the robot: its wheels
+	 * cross them (the simulator's ground truth uses the same 2 cm). The band
+	 * of the mean never gets narrower. [m] */
+	double traversable_step = 0.02;
 	/** Obstacle and drop voxels with fewer samples give no evidence. Any real
 	 * surface within a depth camera's range fills a d_r cell with several
 	 * samples (a 5 cm cell of floor 4.5 m away from a 512x424 Kinect One
@@ -97,6 +111,14 @@ struct IsmParams
 		visit(
 			ParamInfo{"mean_test", 0, 1, "also judge a voxel by its mean against the band of the mean (sigma/sqrt(N))"},
 			p.mean_test);
+		visit(
+			ParamInfo{
+				"measure_floor_offset", 0, 1,
+				"mean test: the plane error term from the floor cells' measured spread instead of d_pth"},
+			p.measure_floor_offset);
+		visit(
+			ParamInfo{"traversable_step", 0, 1, "bumps and dips smaller than this are floor for the robot [m]"},
+			p.traversable_step);
 		visit(
 			ParamInfo{
 				"min_obstacle_points", 1, 1000000,
@@ -250,7 +272,12 @@ class InverseSensorModel
 	 * `band` is the one-sample ground band (groundBand()): a voxel whose top or
 	 * bottom leaves it is an obstacle or a drop; with mean_test, so is one
 	 * whose mean leaves d_pth + (band - d_pth) / sqrt(N). */
-	VoxelClass classify(const ElevationCell& c, double x, double y, const Plane& pl, double band, double& dMean) const;
+	VoxelClass classify(
+		const ElevationCell& c, double x, double y, const Plane& pl, double band, double& dMean,
+		double floorOffset = -1) const;
+	/** The floor cells' measured spread around the plane at the range of
+	 * (x, y, z) from `sensor` (measure_floor_offset), or -1 where unmeasured. */
+	double floorOffset(const Eigen::Vector3d& sensor, double x, double y, double z) const;
 	/** Half-width of the ground band for a voxel at (x, y, z) seen from `sensor`
 	 * (h: sensor height over the plane): d_pth + noise_sigmas * the floor's
 	 * vertical noise at that range, measured in the last compute() or modelled. */
@@ -276,7 +303,9 @@ class InverseSensorModel
 	void buildSupport(const GridGeometry& g, const GroundDetection& det);
 	void measureFloorNoise(const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor);
 
-	std::vector<float> m_floorNoise;  ///< per bin: measured std [m], < 0 = not measured
+	std::vector<float> m_floorNoise;   ///< per bin: measured std [m], < 0 = not measured
+	std::vector<float> m_floorOffset;  ///< per bin: spread of the floor cells' means [m], < 0 = not measured
+	std::vector<float> m_offsetValue, m_offsetSorted;
 	// Floor samples of all bins in one buffer (bounded by the cell count, so
 	// never reallocated per frame): (bin, std) pairs, then grouped by bin.
 	std::vector<uint32_t> m_noiseBin;
