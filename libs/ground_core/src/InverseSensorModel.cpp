@@ -238,6 +238,8 @@ void InverseSensorModel::compute(
 		m_noiseBin.reserve(g.cellCount());
 		m_noiseValue.reserve(g.cellCount());
 		m_noiseSorted.reserve(g.cellCount());
+		m_offsetValue.reserve(g.cellCount());
+		m_offsetSorted.reserve(g.cellCount());
 	}
 	for (uint32_t c : m_evidenceCells) m_evidence[c] = 0.5f;
 	m_evidenceCells.clear();
