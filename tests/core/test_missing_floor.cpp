@@ -80,7 +80,8 @@ void run(const Scene& scene, Result& out, MissingFloorParams p = {})
 	for (size_t i = 0; i < g.cellCount(); i++)
 		if (out.grid.cell(i).count) classes[i] = VoxelClass::Ground;
 
-	Plane floor;  // z = 0
+	Plane floor;           // z = 0
+	p.stats_row_step = 1;  // every row, for the hand counts below
 	out.det.setParams(p);
 	out.det.compute(frame, proj, 1, 4.5, floor, out.grid, classes, out.stats);
 }

@@ -156,7 +156,10 @@ TEST(MissingFloorMap, BlockRangeDecidesWhatBlocks)
 		EXPECT_EQ(g.lastFrame().missing.blocking == 0, range == 0.0) << range;
 		// The camera is at x = 0.1: the cell at x 2.575 is 2.475 m away
 		// (blocks at 2.6 m), the one at x 2.825 2.725 m (does not).
-		if (range == 0.0) EXPECT_NEAR(pOcc(g, 2.7, 0.0), 0.5, 0.05) << "not folded into the grid";
+		if (range == 0.0)
+		{
+			EXPECT_NEAR(pOcc(g, 2.7, 0.0), 0.5, 0.05) << "not folded into the grid";
+		}
 		if (range > 0)
 		{
 			EXPECT_GT(pOcc(g, 2.575, 0.0), 0.5);

@@ -92,30 +92,69 @@ void MissingFloorDetector::compute(
 	// the cell it meets; empty if the camera returned nothing there. Along
 	// each row, pairs of neighbours that both meet seen floor give p11.
 	size_t pairsAfterEmpty = 0, pairsBothEmpty = 0;
+	const int cols = img.cols;
+	if (int(m_rowT.size()) < cols)
+	{
+		m_rowT.resize(size_t(cols));
+		m_rowCx.resize(size_t(cols));
+		m_rowCy.resize(size_t(cols));
+	}
+	// Per ray (1, fy, fz): down = nr.(1, fy, fz), t = -h / down, and the map
+	// point s + t R (1, fy, fz), as fractional cell indices. Float is plenty
+	// for a cell index and lets the row loop vectorize.
+	const float n0 = float(nr.x()), n1 = float(nr.y()), n2 = float(nr.z()), mh = float(-h);
+	const float invRes = float(1.0 / g.resolution);
+	const float bx = float((s.x() - g.x_min) / g.resolution), by = float((s.y() - g.y_min) / g.resolution);
+	const float X0 = float(R(0, 0)) * invRes, X1 = float(R(0, 1)) * invRes, X2 = float(R(0, 2)) * invRes;
+	const float Y0 = float(R(1, 0)) * invRes, Y1 = float(R(1, 1)) * invRes, Y2 = float(R(1, 2)) * invRes;
 	for (int r = 0; r < img.rows; r += step)
 	{
-		int prev = 0;  // previous pixel of the row: 0 none, 1 seen floor, 2 empty on seen floor
-		for (int c = 0; c < img.cols; c += step)
+		const float* __restrict fyRow = projector.rayYRow(r);
+		const float* __restrict fzRow = projector.rayZRow(r);
+		float* __restrict T = m_rowT.data();
+		float* __restrict CX = m_rowCx.data();
+		float* __restrict CY = m_rowCy.data();
+		for (int c = 0; c < cols; c++)
 		{
+			const float fy = fyRow[c], fz = fzRow[c];
+			const float down = n0 + n1 * fy + n2 * fz;
+			// mh < 0: rays going down (down < 0) meet the ground at t > 0; rays
+			// parallel to it or rising get t <= 0 (or -inf), which the next
+			// loop skips. No branch, so the loop vectorizes.
+			const float t = mh / down;
+			T[c] = t;
+			CX[c] = bx + t * (X0 + X1 * fy + X2 * fz);
+			CY[c] = by + t * (Y0 + Y1 * fy + Y2 * fz);
+		}
+		int prev = 0;  // previous pixel of the row: 0 none, 1 seen floor, 2 empty on seen floor
+		const bool statsRow = (r / step) % m_params.stats_row_step == 0;
+		for (int c = 0; c < cols; c += step)
+		{
+			const uint16_t v = img.at(r, c);
+			// Outside the statistics rows only empty rays matter: a return
+			// within the range is never one.
+			if (!statsRow && v != 0 && double(v) * units <= maxRange) continue;
 			const int before = prev;
 			prev = 0;
-			const Eigen::Vector2f f = projector.rayFactor(r, c);
-			const double down = nr.x() + nr.y() * f.x() + nr.z() * f.y();
-			if (!(down < 0)) continue;   // parallel to the ground or rising
-			const double t = -h / down;  // depth at which the ray meets the ground
-			const double norm = img.is_depth ? 1.0 : std::sqrt(1.0 + double(f.x()) * f.x() + double(f.y()) * f.y());
-			const double expected = t * norm;  // in the image's own measure
+			const double t = T[c];  // depth at which the ray meets the ground
+			// (A range along the ray is >= the depth t: t beyond the range is too.)
+			if (!(t > 0) || t > maxRange) continue;
+			double expected = t;  // in the image's own measure
+			if (!img.is_depth)
+			{
+				const double fy = fyRow[c], fz = fzRow[c];
+				expected = t * std::sqrt(1.0 + fy * fy + fz * fz);
+			}
 			if (expected < m_params.min_range || expected > maxRange) continue;
-			const Eigen::Vector3d p = s + t * (R * Eigen::Vector3d(1.0, f.x(), f.y()));
-			const int cx = g.ix(p.x()), cy = g.iy(p.y());
-			if (!g.inside(cx, cy)) continue;
-			const uint16_t v = img.at(r, c);
+			if (!(CX[c] >= 0.f && CY[c] >= 0.f)) continue;
+			const int cx = int(CX[c]), cy = int(CY[c]);
+			if (cx >= g.nx || cy >= g.ny) continue;
 			const double got = double(v) * units;
 			const bool empty = v == 0 || (got > maxRange && got > expected + m_params.beyond_margin);
-			stats.rays++;
+			if (statsRow) stats.rays++;
 			if (empty) stats.empty_rays++;
 			const uint32_t cell = uint32_t(g.index(cx, cy));
-			if (grid.cell(cell).count > 0)
+			if (statsRow && grid.cell(cell).count > 0)
 			{
 				// Seen floor (or whatever was seen there): its dropouts are the
 				// camera's, not a hole's.

@@ -61,6 +61,7 @@ const bool kTraitsRegistered = [] {
 		sink("outliers", ms.outliers);
 		sink("ground", ms.ground);
 		sink("ism", ms.ism);
+		sink("missing_floor", ms.missing);
 		sink("update", g.lastFrameTimes().update);
 	};
 	t.lastGroundPlane = [](const CMetricMap& m, gam::maps::GroundPlaneRecord& r) {

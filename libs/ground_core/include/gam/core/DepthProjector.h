@@ -100,6 +100,10 @@ class DepthProjector
 		return {m_rayY[i], m_rayZ[i]};
 	}
 
+	/** The ray factors of one row of the table (width entries each). */
+	const float* rayYRow(int row) const { return m_rayY.data() + size_t(row) * size_t(m_lutK.width); }
+	const float* rayZRow(int row) const { return m_rayZ.data() + size_t(row) * size_t(m_lutK.width); }
+
 	/** Whether the AVX2 row loop can run here (CPU and build). */
 	static bool avx2Available();
 

@@ -56,6 +56,10 @@ struct MissingFloorParams
 	 * have met counts as "no floor" (a hole deeper than the range); nearer
 	 * returns beyond the range are floor noise at the range limit. [m] */
 	double beyond_margin = 0.10;
+	/** The dropout statistics (q, p11) come from every n-th image row (106
+	 * rows of a 424-row frame are plenty); the empty rays of every row are
+	 * counted. A speed setting: 1 = every row. */
+	int stats_row_step = 4;
 
 	template <class Self, class Visit>
 	static void forEachParam(Self& p, Visit&& visit)
@@ -79,6 +83,9 @@ struct MissingFloorParams
 		visit(
 			ParamInfo{"missing_floor_beyond_margin", 0, 100, "a return this far below the floor is no floor [m]"},
 			p.beyond_margin);
+		visit(
+			ParamInfo{"missing_floor_stats_rows", 1, 1000, "the dropout statistics use every n-th image row"},
+			p.stats_row_step);
 	}
 	/** Throws std::invalid_argument naming the parameter out of range. */
 	void validate() const;
@@ -153,6 +160,9 @@ class MissingFloorDetector
 	std::vector<uint32_t> m_touched, m_cells, m_blocking, m_queue, m_region;
 	std::vector<uint32_t> m_binRays, m_binEmpty;
 	double m_p11 = -1;
+	// One image row: depth at which each ray meets the ground and the
+	// (fractional) grid cell it meets there; computed in a vectorizable loop.
+	std::vector<float> m_rowT, m_rowCx, m_rowCy;
 };
 
 }  // namespace gam
