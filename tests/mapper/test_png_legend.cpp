@@ -28,19 +28,7 @@ std::string darkHoleRawlog()
 {
 	const mrpt::poses::CPose3D kinect(0.1, 0, 0.8, 0, mrpt::DEG2RAD(25.0), 0);
 	auto o = testscene::renderDepth(testscene::floorWithHole(-1, 8, -4, 4, 2.5, 2.9, -0.3, 0.3, 0.3), kinect);
-	const auto R = kinect.getRotationMatrix();
-	const auto& K = o->cameraParams;
-	for (int r = 0; r < int(o->rangeImage.rows()); r++)
-		for (int c = 0; c < int(o->rangeImage.cols()); c++)
-		{
-			const double ky = (K.cx() - c) / K.fx(), kz = (K.cy() - r) / K.fy();
-			const double dz = R(2, 0) + R(2, 1) * ky + R(2, 2) * kz;
-			if (dz >= 0) continue;
-			const double t = -kinect.z() / dz;
-			const double x = kinect.x() + t * (R(0, 0) + R(0, 1) * ky + R(0, 2) * kz);
-			const double y = kinect.y() + t * (R(1, 0) + R(1, 1) * ky + R(1, 2) * kz);
-			if (x >= 2.5 && x <= 2.9 && y >= -0.3 && y <= 0.3) o->rangeImage(r, c) = 0;
-		}
+	testscene::blackOut(*o, 2.5, 2.9, -0.3, 0.3);
 	mrpt::obs::CRawlog log;
 	log.insert(o);
 	fs::create_directories(kTmp);

@@ -97,4 +97,25 @@ inline mrpt::obs::CObservation3DRangeScan::Ptr renderDepth(
 	return o;
 }
 
+/** The pixels of `o` (taken by a robot at the origin) whose ray meets the
+ * floor level z = 0 inside [x0,x1]x[y0,y1] return nothing: a black mat on
+ * the floor, or the opening of a pit whose walls and bottom absorb the light. */
+inline void blackOut(mrpt::obs::CObservation3DRangeScan& o, double x0, double x1, double y0, double y1)
+{
+	const mrpt::poses::CPose3D P = o.sensorPose;
+	const auto R = P.getRotationMatrix();
+	const auto& K = o.cameraParams;
+	for (int r = 0; r < int(o.rangeImage.rows()); r++)
+		for (int c = 0; c < int(o.rangeImage.cols()); c++)
+		{
+			const double ky = (K.cx() - c) / K.fx(), kz = (K.cy() - r) / K.fy();
+			const double dz = R(2, 0) + R(2, 1) * ky + R(2, 2) * kz;
+			if (dz >= 0) continue;
+			const double t = -P.z() / dz;  // depth at which the ray meets z = 0
+			const double x = P.x() + t * (R(0, 0) + R(0, 1) * ky + R(0, 2) * kz);
+			const double y = P.y() + t * (R(1, 0) + R(1, 1) * ky + R(1, 2) * kz);
+			if (x >= x0 && x <= x1 && y >= y0 && y <= y1) o.rangeImage(r, c) = 0;
+		}
+}
+
 }  // namespace testscene

@@ -20,26 +20,7 @@ const CPose3D kKinect(0.1, 0, 0.8, 0, DEG2RAD(25.0), 0);
 
 double pOcc(const COccupancyGridMap2D& g, double x, double y) { return 1.0 - g.getPos(float(x), float(y)); }
 
-/** The pixels of `o` whose ray meets the floor level (z = 0) inside the
- * rectangle return nothing: a black mat lying on the floor, or the opening of
- * a pit whose walls and bottom absorb the light. */
-void blackOut(mrpt::obs::CObservation3DRangeScan& o, double x0, double x1, double y0, double y1)
-{
-	const CPose3D P = o.sensorPose;  // robot at the origin
-	const auto R = P.getRotationMatrix();
-	const auto& K = o.cameraParams;
-	for (int r = 0; r < int(o.rangeImage.rows()); r++)
-		for (int c = 0; c < int(o.rangeImage.cols()); c++)
-		{
-			const double ky = (K.cx() - c) / K.fx(), kz = (K.cy() - r) / K.fy();
-			const double dz = R(2, 0) + R(2, 1) * ky + R(2, 2) * kz;
-			if (dz >= 0) continue;
-			const double t = -P.z() / dz;  // depth at which the ray meets z = 0
-			const double x = P.x() + t * (R(0, 0) + R(0, 1) * ky + R(0, 2) * kz);
-			const double y = P.y() + t * (R(1, 0) + R(1, 1) * ky + R(1, 2) * kz);
-			if (x >= x0 && x <= x1 && y >= y0 && y <= y1) o.rangeImage(r, c) = 0;
-		}
-}
+using testscene::blackOut;
 
 size_t missingCells(const CGroundAwareOccupancyGrid& g)
 {
