@@ -10,6 +10,7 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CRawlog.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -54,7 +55,9 @@ struct ProcessResult
 
 ProcessResult run(const std::string& cmd)
 {
-	const std::string o = std::string(GAM_TEST_TMP_DIR) + "/run.out", e = std::string(GAM_TEST_TMP_DIR) + "/run.err";
+	// One pair of files per process: ctest runs these tests in parallel.
+	const std::string stem = std::string(GAM_TEST_TMP_DIR) + "/run" + std::to_string(getpid());
+	const std::string o = stem + ".out", e = stem + ".err";
 	fs::create_directories(GAM_TEST_TMP_DIR);
 	ProcessResult r;
 	const int s = std::system((cmd + " >" + o + " 2>" + e).c_str());
