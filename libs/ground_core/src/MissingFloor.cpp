@@ -262,7 +262,11 @@ void MissingFloorDetector::compute(
 		{
 			m_mark[c] = kMissing;
 			m_cells.push_back(c);
-			if (dist2(int(c % uint32_t(g.nx)), int(c / uint32_t(g.nx))) <= block2) m_blocking.push_back(c);
+			if (dist2(int(c % uint32_t(g.nx)), int(c / uint32_t(g.nx))) <= block2)
+			{
+				m_mark[c] |= kBlocking;
+				m_blocking.push_back(c);
+			}
 		}
 	}
 	stats.cells = m_cells.size();

@@ -49,10 +49,8 @@ const bool kTraitsRegistered = [] {
 		}
 		for (const char* ext : {".yaml", ".pgm", ".png"}) files.push_back(stem + ext);
 	};
-	t.keepWindow = [](CMetricMap& m, double x, double y, int cells) {
-		// The layer follows the grid's window (missingFloorLayer() re-syncs it).
-		gam::maps::keepGridWindow(m, x, y, cells);
-	};
+	// The missing-floor layer follows the grid's window: missingFloorLayer() re-syncs it.
+	t.keepWindow = gam::maps::keepGridWindow;
 	t.stageTimes = [](const CMetricMap& m, bool depthFrame, const gam::maps::StageSink& sink) {
 		const auto& g = dynamic_cast<const CGroundAwareOccupancyGrid&>(m);
 		if (!depthFrame || !g.lastFrame().valid) return;
@@ -335,7 +333,8 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 		{
 			const int wx = x2idx(g.cx(int(c % uint32_t(g.nx)))), wy = y2idx(g.cy(int(c / uint32_t(g.nx))));
 			if (ev[c] <= 0.5f) continue;
-			if (c < cls.size() && cls[c] == gam::VoxelClass::Obstacle && !missing.isMissing(c))
+			// (A missing-floor cell has no sample, so it is never of class Obstacle.)
+			if (c < cls.size() && cls[c] == gam::VoxelClass::Obstacle)
 				notePositive(wx, wy, t);
 			else
 				noteNegative(wx, wy);
@@ -378,25 +377,21 @@ void CGroundAwareOccupancyGrid::syncMissingLayer() const
 
 namespace
 {
-// A world cell index, independent of the grid's extent: floor(x / res).
+// A world cell index pair, independent of the grid's extent (floor(x / res)),
+// packed in one key.
 int64_t worldKey(int64_t ix, int64_t iy) { return (ix << 32) ^ (iy & 0xffffffffLL); }
 }  // namespace
 
-void CGroundAwareOccupancyGrid::notePositive(int cx, int cy, double t)
+int64_t CGroundAwareOccupancyGrid::worldKeyOf(int cx, int cy) const
 {
 	const double r = getResolution();
-	const int64_t ix = std::llround(std::floor(idx2x(unsigned(cx)) / r)),
-				  iy = std::llround(std::floor(idx2y(unsigned(cy)) / r));
-	m_positiveSeen[worldKey(ix, iy)] = t;
+	return worldKey(
+		std::llround(std::floor(idx2x(unsigned(cx)) / r)), std::llround(std::floor(idx2y(unsigned(cy)) / r)));
 }
 
-void CGroundAwareOccupancyGrid::noteNegative(int cx, int cy)
-{
-	const double r = getResolution();
-	const int64_t ix = std::llround(std::floor(idx2x(unsigned(cx)) / r)),
-				  iy = std::llround(std::floor(idx2y(unsigned(cy)) / r));
-	m_positiveSeen.erase(worldKey(ix, iy));
-}
+void CGroundAwareOccupancyGrid::notePositive(int cx, int cy, double t) { m_positiveSeen[worldKeyOf(cx, cy)] = t; }
+
+void CGroundAwareOccupancyGrid::noteNegative(int cx, int cy) { m_positiveSeen.erase(worldKeyOf(cx, cy)); }
 
 void CGroundAwareOccupancyGrid::decayObstacles(double t)
 {
@@ -476,13 +471,6 @@ void CGroundAwareOccupancyGrid::applyEvidence()
 	// floor within the block range is obstacle evidence of the obstacle gain
 	// (eq. 5 at full density confidence), combined with the ISM's.
 	const float pMissing = float(0.5 + 0.5 * m_options.pipeline.ism.K_m);
-	const auto blocks = [&](uint32_t c) {
-		if (!missing.isMissing(c)) return false;
-		const double dx = g.cx(int(c % uint32_t(g.nx))) - lastFrame().sensor.x();
-		const double dy = g.cy(int(c / uint32_t(g.nx))) - lastFrame().sensor.y();
-		const double r = m_options.pipeline.missing.block_range;
-		return dx * dx + dy * dy <= r * r;
-	};
 	const int sx = int(getSizeX()), sy = int(getSizeY());
 	const auto update = [&](uint32_t c, float pOcc) {
 		const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
@@ -493,9 +481,9 @@ void CGroundAwareOccupancyGrid::applyEvidence()
 		cellType& cell = m_map[size_t(wx) + size_t(wy) * getSizeX()];
 		cell = cellType(std::clamp(int(cell) + l, int(OCCGRID_CELLTYPE_MIN), int(OCCGRID_CELLTYPE_MAX)));
 	};
-	for (uint32_t c : cells) update(c, blocks(c) ? gam::ism::combine(ev[c], pMissing) : ev[c]);
-	for (uint32_t c : missingCells)
-		if (ev[c] == 0.5f && blocks(c)) update(c, pMissing);
+	for (uint32_t c : cells) update(c, missing.isBlocking(c) ? gam::ism::combine(ev[c], pMissing) : ev[c]);
+	for (uint32_t c : missing.blockingCells())
+		if (ev[c] == 0.5f) update(c, pMissing);
 
 	// The missing-floor layer: this frame's judgement replaces the old one;
 	// floor seen clears a cell.

@@ -140,7 +140,9 @@ class MissingFloorDetector
 	const std::vector<uint32_t>& cells() const { return m_cells; }
 	/** Those within block_range of the sensor. */
 	const std::vector<uint32_t>& blockingCells() const { return m_blocking; }
-	bool isMissing(uint32_t cell) const { return cell < m_mark.size() && m_mark[cell] == kMissing; }
+	bool isMissing(uint32_t cell) const { return cell < m_mark.size() && (m_mark[cell] & kMissing); }
+	/** Missing and within block_range of the sensor (one of blockingCells()). */
+	bool isBlocking(uint32_t cell) const { return cell < m_mark.size() && (m_mark[cell] & kBlocking); }
 	/** Empty rays per frame cell in the last frame (0 where none). */
 	uint16_t emptyRays(uint32_t cell) const { return cell < m_empty.size() ? m_empty[cell] : 0; }
 	/** The dropout rate of seen floor measured in the last frame at depth
@@ -153,7 +155,7 @@ class MissingFloorDetector
 	double neighbourDropoutRate() const { return m_p11; }
 
    private:
-	static constexpr uint8_t kCandidate = 1, kMissing = 2, kVisited = 4;
+	static constexpr uint8_t kCandidate = 1, kMissing = 2, kVisited = 4, kBlocking = 8;
 	MissingFloorParams m_params;
 	std::vector<uint16_t> m_empty;  ///< per frame cell
 	std::vector<uint8_t> m_mark;    ///< per frame cell

@@ -171,6 +171,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	/** obstacle_decay_s: records positive obstacle cells seen at time `t`,
 	 * forgets negative ones, and returns to unknown the positive ones older
 	 * than the decay time. */
+	int64_t worldKeyOf(int cx, int cy) const;
 	void notePositive(int cx, int cy, double t);
 	void noteNegative(int cx, int cy);
 	void decayObstacles(double t);
