@@ -42,11 +42,16 @@ double groundRay(double cDist, double cvDist, const IsmParams& p)
 }
 }  // namespace paper
 
+double InverseSensorModel::rangeFrom(const Eigen::Vector3d& sensor, double x, double y, double z)
+{
+	const double dx = x - sensor.x(), dy = y - sensor.y(), dz = z - sensor.z();
+	return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
 double InverseSensorModel::groundBand(const Eigen::Vector3d& sensor, double h, double x, double y, double z) const
 {
 	if (m_params.noise_sigmas <= 0) return m_params.d_pth;
-	const double dx = x - sensor.x(), dy = y - sensor.y(), dz = z - sensor.z();
-	const double r = std::sqrt(dx * dx + dy * dy + dz * dz);
+	const double r = rangeFrom(sensor, x, y, z);
 	if (r < 1e-3) return m_params.d_pth;
 	// The floor's vertical scatter measured in this frame at this range, if
 	// enough floor was seen there; else the sensor model.
@@ -81,8 +86,7 @@ void InverseSensorModel::measureFloorNoise(
 		const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
 		const Plane& pl = choosePlane(det, c, x, y, block);
 		if (std::abs(pl.signedDistance(x, y, c.mean())) > m_params.d_pth) continue;
-		const Eigen::Vector3d d(x - sensor.x(), y - sensor.y(), c.mean() - sensor.z());
-		const size_t bin = size_t(d.norm() / m_params.floor_noise_bin);
+		const size_t bin = size_t(rangeFrom(sensor, x, y, c.mean()) / m_params.floor_noise_bin);
 		if (bin < nb)
 		{
 			m_noiseBin.push_back(uint32_t(bin));
@@ -122,8 +126,7 @@ void InverseSensorModel::measureFloorNoise(
 double InverseSensorModel::floorOffset(const Eigen::Vector3d& sensor, double x, double y, double z) const
 {
 	if (!m_params.measure_floor_offset) return -1;
-	const double dx = x - sensor.x(), dy = y - sensor.y(), dz = z - sensor.z();
-	const size_t bin = size_t(std::sqrt(dx * dx + dy * dy + dz * dz) / m_params.floor_noise_bin);
+	const size_t bin = size_t(rangeFrom(sensor, x, y, z) / m_params.floor_noise_bin);
 	return bin < m_floorOffset.size() ? double(m_floorOffset[bin]) : -1;
 }
 

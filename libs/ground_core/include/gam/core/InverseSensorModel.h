@@ -284,6 +284,9 @@ class InverseSensorModel
 	double groundBand(const Eigen::Vector3d& sensor, double sensorHeight, double x, double y, double z) const;
 
    private:
+	/** Distance of (x, y, z) from the sensor: the range the floor-noise and
+	 * floor-offset bins are indexed by. */
+	static double rangeFrom(const Eigen::Vector3d& sensor, double x, double y, double z);
 	void put(uint32_t cell, float p);
 	void computePaper(
 		const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, IsmStats& stats);
