@@ -46,7 +46,10 @@ awk -v v="$ga" 'BEGIN { exit !(v + 0 >= 1.0 && v + 0 <= 5.0) }' || fail "approac
 "$tool" --from "$w/single/detections.csv" --commit smoke >"$w/from.txt" || fail "--from"
 cmp -s <(grep '^| hole_' "$w/single.txt") <(grep '^| hole_' "$w/from.txt") || fail "--from gives other tables"
 
-"$tool" --help | grep -q "usage: rawlog_tools/gam-detection-range" || fail "--help"
+# (Into a file: grep -q in a pipe may close it before the help is written,
+# and the tool then dies of a broken pipe -- a flaky failure under pipefail.)
+"$tool" --help >"$w/help.txt" || fail "--help exit status"
+grep -q "usage: rawlog_tools/gam-detection-range" "$w/help.txt" || fail "--help"
 set +e
 "$tool" --bogus 2>"$w/err"
 [[ $? -eq 2 && "$(wc -l <"$w/err")" -eq 1 ]] || fail "unknown option: exit 2, one line"
