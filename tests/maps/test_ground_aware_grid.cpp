@@ -25,6 +25,16 @@ std::vector<Box> holeAndBoxScene()
 }
 
 double pOcc(const COccupancyGridMap2D& g, double x, double y) { return 1.0 - g.getPos(float(x), float(y)); }
+// The most occupied of the cell at (x, y) and its 8 neighbours: a beam's end
+// point is one cell, which a point on the same arc may miss by a cell.
+double pOccNear(const COccupancyGridMap2D& g, double x, double y)
+{
+	const double r = g.getResolution();
+	double p = 0;
+	for (int dy = -1; dy <= 1; dy++)
+		for (int dx = -1; dx <= 1; dx++) p = std::max(p, pOcc(g, x + dx * r, y + dy * r));
+	return p;
+}
 
 // A Leddar IS16 (16 segments over 45 deg) 0.3 m up, seeing a wall 3 m ahead.
 mrpt::obs::CObservation2DRangeScan leddarWallScan()
@@ -191,13 +201,50 @@ TEST(GroundAwareGrid, LeddarScanFusesThroughTheBeamModel)
 	ASSERT_TRUE(plain.insertObservation(s));
 	for (const auto* m : {&g, &plain})
 	{
-		EXPECT_GT(pOcc(*m, 3.0, 0.0), 0.6);
-		EXPECT_GT(pOcc(*m, 3.0, 0.9), 0.6) << "edge segment covered (upsampled beams)";
+		EXPECT_GT(pOccNear(*m, 3.0, 0.0), 0.6);
+		EXPECT_GT(pOccNear(*m, 3.0, 0.9), 0.6) << "edge segment covered (upsampled beams)";
 	}
 	// The plain beam model frees the space before the wall; by default a
 	// planar scan does not turn unknown floor into free floor.
 	EXPECT_LT(pOcc(plain, 1.5, 0.0), 0.4);
 	EXPECT_NEAR(pOcc(g, 1.5, 0.0), 0.5, 1e-3);
+}
+
+TEST(GroundAwareGrid, LeddarSegmentEchoStaysInItsOwnCone)
+{
+	// 16 segments over a 45 deg aperture: segment i points at -22.5 + 3 i deg
+	// (s = 45 / 15 = 3 deg) and covers 3 deg around it. Upsampled with k = 8,
+	// its rays are 3 / 8 = 0.375 deg apart: segment 0's at -22.5 - 1.5 +
+	// 0.1875 = -23.8125 ... -21.1875 deg, and the new aperture is
+	// (16 * 8 - 1) * 3 / 8 = 47.625 deg.
+	mrpt::obs::CObservation2DRangeScan s;
+	s.aperture = float(DEG2RAD(45.0));
+	s.rightToLeft = true;
+	s.maxRange = 50;
+	s.resizeScan(16);
+	for (size_t i = 0; i < 16; i++) s.setScanRangeValidity(i, false);
+	s.setScanRange(0, 6.0f);  // only segment 0 has an echo, 6 m away
+	s.setScanRangeValidity(0, true);
+	const auto up = CGroundAwareOccupancyGrid::upsampleSparseScan(s, 8);
+	ASSERT_EQ(up.getScanSize(), 128u);
+	EXPECT_NEAR(up.aperture, DEG2RAD(47.625), 1e-5);
+	for (size_t o = 0; o < 8; o++) EXPECT_TRUE(up.getScanRangeValidity(o));
+	EXPECT_FALSE(up.getScanRangeValidity(8));
+
+	CGroundAwareOccupancyGrid g(-8, 8, -8, 8, 0.05f);
+	ASSERT_TRUE(g.insertObservation(s));
+	auto x = [](double deg) { return 6.0 * std::cos(DEG2RAD(deg)); };
+	auto y = [](double deg) { return 6.0 * std::sin(DEG2RAD(deg)); };
+	// The whole cone is marked (within a cell: rays 6 m x 0.375 deg = 3.9 cm
+	// apart on 5 cm cells), its outer edge too: the old rays stopped at
+	// -22.5 deg, the first beam's centre.
+	EXPECT_GT(pOccNear(g, x(-23.7), y(-23.7)), 0.6) << "outer edge of segment 0";
+	EXPECT_GT(pOccNear(g, x(-22.5), y(-22.5)), 0.6) << "centre of segment 0";
+	EXPECT_GT(pOccNear(g, x(-21.3), y(-21.3)), 0.6) << "inner edge of segment 0";
+	// Nothing inside segment 1's cone (-21 ... -18 deg) from 0.6 deg past its
+	// border on (6 m x 0.6 deg = 6 cm, more than a 5 cm cell; the old rays
+	// reached -20.0 deg).
+	for (double deg = -20.4; deg <= -18.0; deg += 0.2) EXPECT_NEAR(pOcc(g, x(deg), y(deg)), 0.5, 1e-3) << deg << " deg";
 }
 
 TEST(GroundAwareGrid, LeddarBeamsOverAHoleDoNotClearIt)

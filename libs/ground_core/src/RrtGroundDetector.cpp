@@ -287,6 +287,8 @@ void RrtGroundDetector::reserveScratch(const GridGeometry& g)
 	m_absDist.reserve(maxNodes);
 	m_cluster.reserve(maxNodes);
 	m_bfs.reserve(maxNodes);
+	m_patchNodes.reserve(maxNodes);
+	m_deferred.reserve(size_t(2 * std::max(1, m_params.max_planes)));
 	if (m_hasNode.size() != g.cellCount())
 	{
 		m_hasNode.assign(g.cellCount(), 0);
@@ -678,6 +680,8 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 	rp.max_horizontal_normal = m_params.normal_threshold;
 	out.planes.reserve(size_t(m_params.max_planes));
 	out.plane_support.reserve(size_t(m_params.max_planes));
+	m_patchNodes.clear();
+	m_deferred.clear();
 
 	// Keeps the remaining nodes whose m_flag is 0, in order.
 	auto keepUnflagged = [&]() {
@@ -780,6 +784,31 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 			rp.inlier_distance = noiseBand(m_params.ransac_inlier_distance);
 			out.patch_inlier_distance = rp.inlier_distance;
 		}
+		if (k > 0)
+		{
+			// A ground patch joins the ground it is reached from without a
+			// step: a ramp meets the floor along its foot, a landing meets its
+			// ramp. The flat floor 5 cm below a small downward step is parallel
+			// to the floor above and meets it nowhere; the tree crosses that
+			// step (E_th is 5 cm, and a node whose window straddles the edge
+			// is tilted) and fill_patches tiled the lower level, whose plane
+			// then freed it as ground, edge and all (the 5 cm step of the
+			// detection-range approach was lost from 3.5 to 3.0 m). A patch
+			// that joins no accepted plane yet (a landing whose ramp has not
+			// been fitted) waits until one is accepted.
+			const size_t begin = m_patchNodes.size();
+			for (size_t i : r.inliers) m_patchNodes.push_back(remaining[i]);
+			m_flag.assign(remaining.size(), 0);
+			for (size_t i : r.inliers) m_flag[i] = 1;
+			keepUnflagged();
+			if (!joinsAcceptedPlane(plane, begin, m_patchNodes.size(), out, rp.inlier_distance))
+			{
+				m_deferred.push_back({plane, begin, m_patchNodes.size(), false});
+				continue;
+			}
+			acceptPatch(plane, begin, m_patchNodes.size(), out);
+			continue;
+		}
 		const int id = int(out.planes.size());
 		out.planes.push_back(plane);
 		out.plane_support.push_back(r.inliers.size());
@@ -791,6 +820,53 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		}
 		keepUnflagged();
 	}
+	// Patches set aside: each accepted plane may be the one they join.
+	for (bool more = true; more && int(out.planes.size()) < maxPlanes;)
+	{
+		more = false;
+		for (DeferredPatch& dp : m_deferred)
+			if (!dp.taken && int(out.planes.size()) < maxPlanes &&
+				joinsAcceptedPlane(dp.plane, dp.begin, dp.end, out, rp.inlier_distance))
+			{
+				dp.taken = true;
+				acceptPatch(dp.plane, dp.begin, dp.end, out);
+				more = true;
+			}
+	}
+}
+
+void RrtGroundDetector::acceptPatch(const Plane& plane, size_t begin, size_t end, GroundDetection& out)
+{
+	const int id = int(out.planes.size());
+	out.planes.push_back(plane);
+	out.plane_support.push_back(end - begin);
+	for (size_t a = begin; a < end; a++) out.nodes[m_patchNodes[a]].plane_id = id;
+}
+
+bool RrtGroundDetector::joinsAcceptedPlane(
+	const Plane& plane, size_t begin, size_t end, const GroundDetection& out, double tol) const
+{
+	// Between a patch node p and an accepted node q at most d_n apart (a tree
+	// step), the patch and q's plane Q meet if the patch's height over Q
+	// changes sign from p to q, or is within the noise band `tol` at either.
+	// Two such pairs (one can be a node whose window straddles an edge).
+	const double link2 = m_params.expansion_distance * m_params.expansion_distance;
+	int joins = 0;
+	for (size_t a = begin; a < end; a++)
+	{
+		const GroundNode& p = out.nodes[m_patchNodes[a]];
+		for (const GroundNode& q : out.nodes)
+		{
+			if (q.plane_id < 0) continue;
+			const double dx = double(p.x) - q.x, dy = double(p.y) - q.y;
+			if (dx * dx + dy * dy > link2) continue;
+			const Plane& Q = out.planes[size_t(q.plane_id)];
+			const double atP = plane.heightAt(p.x, p.y) - Q.heightAt(p.x, p.y);
+			const double atQ = plane.heightAt(q.x, q.y) - Q.heightAt(q.x, q.y);
+			if (((atP > 0) != (atQ > 0) || std::min(std::abs(atP), std::abs(atQ)) <= tol) && ++joins >= 2) return true;
+		}
+	}
+	return false;
 }
 
 }  // namespace gam

@@ -210,6 +210,14 @@ mrpt::obs::CObservation2DRangeScan CGroundAwareOccupancyGrid::upsampleSparseScan
 	const size_t N = in.getScanSize();
 	if (k <= 1 || N == 0 || N >= 64) return in;
 	mrpt::obs::CObservation2DRangeScan out = in;
+	// Beam i points at -aperture/2 + i s (s = aperture / (N - 1)) and covers
+	// s around it: its k rays sit at the centres of k equal parts of that
+	// cone, s / k apart. So the new aperture spans N k - 1 of those steps. (It
+	// kept the old aperture, which squeezed the rays inward: an edge segment
+	// lost the outer half of its cone, and a segment's echo was drawn up to
+	// 1.1 deg (k = 8) inside its neighbour's cone, behind the wall the
+	// neighbour saw nearer when it met a wall at a grazing angle.)
+	if (N > 1) out.aperture = float(double(in.aperture) / double(N - 1) * double(N * size_t(k) - 1) / double(k));
 	out.resizeScan(N * size_t(k));
 	for (size_t i = 0; i < N; i++)
 		for (int j = 0; j < k; j++)

@@ -258,6 +258,12 @@ class RrtGroundDetector
 	/** 3 sigma of the distances in m_absDist (robust) + the cell quantisation
 	 * d_r / 2 * tan(asin N_th), at most `cap` (see fitPlanes). */
 	double noiseBand(double cap);
+	/** True if the patch `plane` (on the nodes m_patchNodes[begin, end)) meets
+	 * an accepted plane between neighbouring nodes, not across a step of more
+	 * than `tol` (see fitPlanes). */
+	bool joinsAcceptedPlane(const Plane& plane, size_t begin, size_t end, const GroundDetection& out, double tol) const;
+	/** Appends `plane` as a patch held by the nodes m_patchNodes[begin, end). */
+	void acceptPatch(const Plane& plane, size_t begin, size_t end, GroundDetection& out);
 	std::vector<int> m_cluster;
 	std::vector<size_t> m_bfs;
 	/** fill_patches: adds nodes over the ground off `ground` (see RrtGpdParams). */
@@ -295,6 +301,16 @@ class RrtGroundDetector
 	std::vector<uint8_t> m_flag;
 	std::vector<Eigen::Vector3d> m_ransacPts, m_ransacInliers;
 	RansacResult m_ransac;
+	// Extra patches set aside until a plane they join is accepted: their
+	// nodes in m_patchNodes[begin, end).
+	struct DeferredPatch
+	{
+		Plane plane;
+		size_t begin = 0, end = 0;
+		bool taken = false;
+	};
+	std::vector<DeferredPatch> m_deferred;
+	std::vector<size_t> m_patchNodes;
 };
 
 }  // namespace gam

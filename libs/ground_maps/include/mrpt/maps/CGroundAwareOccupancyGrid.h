@@ -143,7 +143,10 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	bool isMissingFloor(float x, float y) const;
 
 	/** Splits each beam of a sparse scan (< 64 beams, e.g. a 16-segment Leddar)
-	 * into k rays, so the base beam model covers each segment's full width. */
+	 * into k rays, so the base beam model covers each segment's full width:
+	 * beam i (at -aperture/2 + i s, s = aperture / (N - 1)) covers s around
+	 * its direction, and its rays sit s / k apart inside that cone (the
+	 * aperture grows to (N k - 1) s / k). */
 	static mrpt::obs::CObservation2DRangeScan upsampleSparseScan(
 		const mrpt::obs::CObservation2DRangeScan& in, int raysPerBeam);
 
