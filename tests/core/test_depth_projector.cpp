@@ -579,3 +579,103 @@ TEST(DepthProjector, Avx2AndBaselineRowLoopsAgreeBitForBit)
 		}
 	}
 }
+
+namespace
+{
+/** One image row of depths in millimetres, in a 5-row image (the same row
+ * repeated: no vertical edge), for the flying-pixel test along the row. */
+Image rowImage(const std::vector<int>& mm)
+{
+	Image img(5, int(mm.size()), mm.size());
+	for (int r = 0; r < 5; r++)
+		for (size_t c = 0; c < mm.size(); c++) img.at(r, int(c)) = uint16_t(mm[c]);
+	return img;
+}
+}  // namespace
+
+TEST(DepthProjector, FlyingPixelsAreTheMixedPixelsOfAnEdge)
+{
+	const float tol = 50;  // mm: one 5 cm cell
+	// A desk edge at 1.0 m in front of a wall at 2.0 m; pixel 5 is mixed
+	// (1.5 m): between 1000 and 2000, 500 mm from each; the pixels on its left
+	// predict 1 / (2/1000 - 1/1000) = 1000 and those on its right 2000, both
+	// 500 > 50 mm from 1500: flying. The edge pixels 4 (1000 on the desk)
+	// and 6 (2000 on the wall) each continue their own side: not flying.
+	{
+		const Image img = rowImage({1000, 1000, 1000, 1000, 1000, 1500, 2000, 2000, 2000, 2000, 2000});
+		EXPECT_TRUE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 4, 1, tol));
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 6, 1, tol));
+	}
+	// Both sides mixed: 1300 and 1320 are within 50 mm of each other and
+	// between 1000 and 2000 as a pair: both flying.
+	{
+		const Image img = rowImage({1000, 1000, 1000, 1000, 1000, 1300, 1320, 2000, 2000, 2000, 2000, 2000});
+		EXPECT_TRUE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
+		EXPECT_TRUE(DepthProjector::isFlyingPixel(img.view(), 2, 6, 1, tol));
+	}
+	// A thin object (a cable 1 pixel wide at 0.8 m) is nearer than both
+	// neighbours, not between them: kept.
+	{
+		const Image img = rowImage({1000, 1000, 1000, 1000, 1000, 800, 1000, 1000, 1000, 1000, 1000});
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
+	}
+	// A surface seen at a grazing angle: on a plane the inverse depth is
+	// affine in the pixel, here 1/d = (250 - 3 c) / 1e6 per mm, so d = 4000,
+	// 4049, 4098, 4149, 4202, 4255, 4310, ... mm: steps of ~50-55 mm, each
+	// pixel between its neighbours and more than 50 mm from the next, but
+	// each side predicts it exactly: not flying.
+	{
+		std::vector<int> mm;
+		for (int c = 0; c < 11; c++) mm.push_back(int(std::lround(1e6 / (250.0 - 3.0 * c))));
+		ASSERT_EQ(mm[1], 4049);
+		ASSERT_EQ(mm[6], 4310);
+		const Image img = rowImage(mm);
+		EXPECT_GT(mm[6] - mm[5], 50);
+		EXPECT_GT(mm[5] - mm[4], 50);
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
+	}
+	// A neighbour without a return (0) predicts nothing and is no side:
+	// 1500 next to a dropout is kept.
+	{
+		const Image img = rowImage({1000, 1000, 1000, 1000, 0, 1500, 2000, 2000, 2000, 2000, 2000});
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
+	}
+}
+
+TEST(DepthProjector, FlyingPixelFilterDropsExactlyTheFlyingPixels)
+{
+	// A wall at 3 m with a box face at 1.5 m in front of it, random mixed
+	// pixels on the box's outline and noise: project() with the filter keeps
+	// the pixels its own projection keeps minus those isFlyingPixel() flags
+	// (the fast first pass must not lose one).
+	Image img;
+	std::mt19937 rng(7);
+	std::uniform_real_distribution<double> u(0, 1);
+	std::normal_distribution<double> noise(0, 3);
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+		{
+			const bool box = r >= 12 && r < 36 && c >= 20 && c < 44;
+			const bool edge = box && (r == 12 || r == 35 || c == 20 || c == 43);
+			double mm = box ? 1500 : 3000;
+			if (edge && u(rng) < 0.6) mm = 1500 + (0.15 + 0.7 * u(rng)) * 1500;
+			img.at(r, c) = uint16_t(std::lround(mm + noise(rng)));
+		}
+	img.at(5, 5) = 0;  // a dropout
+	const ElevationGrid grid(makeGeometry(-5, -5, 0.05, 200, 200));
+	const RigidTransform T = pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+	DepthProjector proj;
+	ProjectionFilter keepAll, dropFlying;
+	keepAll.drop_flying_pixels = false;
+	keepAll.max_range = dropFlying.max_range = 10;
+	BinnedPoints all, kept;
+	const size_t nAll = proj.project(img.view(), camera(), T, keepAll, grid, all);
+	const size_t nKept = proj.project(img.view(), camera(), T, dropFlying, grid, kept);
+	size_t flying = 0;
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++) flying += DepthProjector::isFlyingPixel(img.view(), r, c, 1, 50.0f);
+	EXPECT_EQ(nAll, size_t(W * H - 1));
+	EXPECT_GT(flying, 20u) << "the outline's mixed pixels";
+	EXPECT_EQ(nKept, nAll - flying);
+}

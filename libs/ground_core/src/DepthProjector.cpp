@@ -3,6 +3,7 @@
 #include "ProjectRow.h"
 
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -31,6 +32,7 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 	m_rayInvNorm.resize(n);
 	m_rowCell.resize(size_t(K.width));
 	m_rowZ.resize(size_t(K.width));
+	m_rowKeep.resize(size_t(K.width));
 	const bool distorted = K.k1 != 0 || K.k2 != 0 || K.k3 != 0 || K.p1 != 0 || K.p2 != 0;
 	for (int r = 0; r < K.height; r++)
 	{
@@ -87,7 +89,114 @@ void projectRowDecimated(
 			projectPixel<false>(p, row[c], ky[c], kz[c], invNorm[c], cell[k], z[k]);
 	}
 }
+// Whether the surface through `far` and `near` (the two pixels on one side,
+// `near` the adjacent one) continues to depth d within tol: on a plane the
+// inverse depth is affine in the pixel coordinates.
+inline bool continues(float far, float near, float d, float tol)
+{
+	if (!(far > 0) || !(near > 0)) return false;
+	const float inv = 2.0f / near - 1.0f / far;
+	return inv > 0 && std::abs(1.0f / inv - d) <= tol;
+}
+
+// Strictly between a and b, more than tol from each.
+inline bool between(float a, float d, float b, float tol)
+{
+	return a > 0 && b > 0 && (d - a) * (b - d) > 0 && std::abs(d - a) > tol && std::abs(d - b) > tol;
+}
+
+// Along one line of the image (a row or a column), the values v[0..6] at
+// offsets -3 ... +3 steps (0 outside the image): see
+// DepthProjector::isFlyingPixel. Mixed pixels come alone or in pairs (both
+// sides of an edge can mix): a pair is two pixels within tol of each other,
+// between the pixels around it, that continues neither side.
+bool flyingAlong(const float* v, float tol)
+{
+	const float d = v[3];
+	if (between(v[2], d, v[4], tol) && !continues(v[1], v[2], d, tol) && !continues(v[5], v[4], d, tol)) return true;
+	// paired with the next pixel
+	if (std::abs(v[4] - d) <= tol && between(v[2], d, v[5], tol) && between(v[2], v[4], v[5], tol) &&
+		!continues(v[1], v[2], d, tol) && !continues(v[6], v[5], v[4], tol))
+		return true;
+	// paired with the previous pixel
+	return std::abs(v[2] - d) <= tol && between(v[1], d, v[4], tol) && between(v[1], v[2], v[4], tol) &&
+		   !continues(v[0], v[1], v[2], tol) && !continues(v[5], v[4], d, tol);
+}
+
+// Both lines through pixel (r, c), neighbours `step` apart.
+bool flyingAt(const RangeImageView& img, int r, int c, int step, float tol)
+{
+	float h[7], w[7];
+	const int reach = 3 * step;
+	if (r >= reach && c >= reach && r + reach < img.rows && c + reach < img.cols)
+	{
+		const uint16_t* p = img.data + size_t(r) * img.stride + size_t(c);
+		if (p[0] == 0) return false;
+		const ptrdiff_t down = ptrdiff_t(img.stride) * step;
+		for (int o = -3; o <= 3; o++)
+		{
+			h[o + 3] = float(p[o * step]);
+			w[o + 3] = float(p[o * down]);
+		}
+	}
+	else
+	{
+		auto v = [&](int rr, int cc) -> float {
+			return (rr < 0 || cc < 0 || rr >= img.rows || cc >= img.cols) ? 0.f : float(img.at(rr, cc));
+		};
+		if (!(v(r, c) > 0)) return false;
+		for (int o = -3; o <= 3; o++)
+		{
+			h[o + 3] = v(r, c + o * step);
+			w[o + 3] = v(r + o * step, c);
+		}
+	}
+	return flyingAlong(h, tol) || flyingAlong(w, tol);
+}
+
+// Marks the flying pixels of row r (every dec-th column) in keep[k] = 0.
+// A branch-free pass (it vectorizes) keeps every pixel that continues the
+// surface on one side along both lines through it, in depth: two pixels
+// a2, a predict 2a - a2, within tol / 2 (a plane's depth is affine in inverse
+// depth, not in depth; over three pixels the difference is a few mm at
+// most), or that is within tol of both neighbours of a side it fails.
+// The few others get the full test (flyingAt).
+void markFlyingRow(const RangeImageView& img, int r, int dec, float tol, bool avx2, uint8_t* keep)
+{
+	const int cols = img.cols, used = (cols + dec - 1) / dec;
+	if (dec != 1 || cols < 5 || r < 2 || r + 2 >= img.rows)
+	{
+		for (int k = 0; k < used; k++) keep[k] = uint8_t(!flyingAt(img, r, k * dec, dec, tol));
+		return;
+	}
+	const uint16_t* row = img.data + size_t(r) * img.stride;
+	const uint16_t *u1 = row - img.stride, *u2 = u1 - img.stride;
+	const uint16_t *d1 = row + img.stride, *d2 = d1 + img.stride;
+	const int t = int(tol), h = int(tol / 2);
+	if (avx2)
+		detail::flyingCandidatesAvx2(u2, u1, row, d1, d2, cols, t, h, keep);
+	else
+		flyingCandidates(u2, u1, row, d1, d2, cols, t, h, keep);
+	// The candidates are few: skip 8 kept pixels at a time.
+	int k = 0;
+	for (; k + 8 <= cols; k += 8)
+	{
+		uint64_t eight;
+		std::memcpy(&eight, keep + k, 8);
+		if (eight == 0x0101010101010101ull) continue;
+		for (int j = k; j < k + 8; j++)
+			if (!keep[j]) keep[j] = uint8_t(!flyingAt(img, r, j, 1, tol));
+	}
+	for (; k < cols; k++)
+		if (!keep[k]) keep[k] = uint8_t(!flyingAt(img, r, k, 1, tol));
+}
 }  // namespace
+
+bool DepthProjector::isFlyingPixel(const RangeImageView& img, int row, int col, int step, float tol)
+{
+	if (row < 0 || col < 0 || row >= img.rows || col >= img.cols || step < 1) return false;
+	return flyingAt(img, row, col, step, tol);
+}
 
 size_t DepthProjector::project(
 	const RangeImageView& img, const PinholeIntrinsics& K, const RigidTransform& T, const ProjectionFilter& f,
@@ -140,6 +249,10 @@ size_t DepthProjector::project(
 	int32_t* rowCell = m_rowCell.data();
 	float* rowZ = m_rowZ.data();
 	const bool useAvx2 = m_allowAvx2 && detail::avx2RowLoopAvailable();
+	// Flying pixels: one grid cell of tolerance (a smaller error moves a point
+	// by less than a cell), in image units.
+	const float flyTol = float(g.resolution / double(img.units));
+	uint8_t* keep = m_rowKeep.data();
 
 	for (int r = 0; r < img.rows; r += dec)
 	{
@@ -161,12 +274,23 @@ size_t DepthProjector::project(
 		// Compaction: every pixel is written at outCell[n], only the valid ones
 		// advance n (branch-free: valid and invalid pixels interleave at random).
 		const int used = int(colsUsed);
-		for (int k = 0; k < used; k++)
+		if (f.drop_flying_pixels)
 		{
-			outCell[n] = uint32_t(rowCell[k]);
-			outZ[n] = rowZ[k];
-			n += size_t(rowCell[k] >= 0);
+			markFlyingRow(img, r, dec, flyTol, useAvx2, keep);
+			for (int k = 0; k < used; k++)
+			{
+				outCell[n] = uint32_t(rowCell[k]);
+				outZ[n] = rowZ[k];
+				n += size_t(rowCell[k] >= 0) & size_t(keep[k]);
+			}
 		}
+		else
+			for (int k = 0; k < used; k++)
+			{
+				outCell[n] = uint32_t(rowCell[k]);
+				outZ[n] = rowZ[k];
+				n += size_t(rowCell[k] >= 0);
+			}
 	}
 	out.commit(n);
 	return n - start;

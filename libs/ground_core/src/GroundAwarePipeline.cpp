@@ -40,6 +40,8 @@ ProjectionFilter PipelineParams::projectionFilter(double robotZ) const
 	// (Not in the paper's model, which keeps everything the projection band holds.)
 	const bool crop = ism.model != MethodVariant::Paper;
 	f.z_max = float(robotZ + (crop ? std::min<double>(projection.z_max, ism.robot_height) : projection.z_max));
+	// The paper projects every pixel.
+	if (ism.model == MethodVariant::Paper) f.drop_flying_pixels = false;
 	return f;
 }
 

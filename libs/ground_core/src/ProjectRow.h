@@ -5,7 +5,9 @@
 // can never be mixed up by the linker.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 
 #include "gam/core/DepthProjector.h"
 
@@ -27,6 +29,9 @@ bool avx2RowLoopAvailable();
 void projectRowAvx2(
 	bool isDepth, const RowParams& p, const uint16_t* row, const float* ky, const float* kz, const float* invNorm,
 	int cols, int32_t* cell, float* z);
+void flyingCandidatesAvx2(
+	const uint16_t* u2, const uint16_t* u1, const uint16_t* row, const uint16_t* d1, const uint16_t* d2, int cols,
+	int t, int h, uint8_t* keep);
 }  // namespace detail
 
 namespace
@@ -71,6 +76,35 @@ inline void projectRow(
 		projectRowLoop<true>(p, row, ky, kz, invNorm, cols, cell, z);
 	else
 		projectRowLoop<false>(p, row, ky, kz, invNorm, cols, cell, z);
+}
+
+// The flying-pixel filter's first pass over a row (rows u2, u1 above it, d1,
+// d2 below; see markFlyingRow in DepthProjector.cpp): keep[c] = 1 for every
+// pixel that cannot be flying, 0 for the candidates (and the two pixels at
+// each end). A line (p2, p1, x, n1, n2) clears x when one side continues to
+// it in depth (|2 p1 - p2 - x| <= h), when x jumps by more than t to neither
+// neighbour (then it is between none) or when a neighbour has no return.
+// All in 16-bit arithmetic (16 pixels per AVX2 instruction): |e| <= h is
+// tested as (e + h) mod 2^16 <= 2 h, which can wrongly clear a pixel only
+// when |2 p1 - p2 - x| >= 2^16 - h, i.e. for depths over 2^15 units (33 m
+// in millimetres); it never makes a kept pixel a candidate.
+inline void flyingCandidates(
+	const uint16_t* __restrict u2, const uint16_t* __restrict u1, const uint16_t* __restrict row,
+	const uint16_t* __restrict d1, const uint16_t* __restrict d2, int cols, int t, int h, uint8_t* __restrict keep)
+{
+	const uint16_t T = uint16_t(std::min(t, 65535)), H = uint16_t(std::min(h, 16383)), H2 = uint16_t(2 * H);
+	auto calm = [&](uint16_t p2, uint16_t p1, uint16_t x, uint16_t n1, uint16_t n2) -> uint16_t {
+		const uint16_t el = uint16_t(uint16_t(2 * p1 - p2 - x) + H), er = uint16_t(uint16_t(2 * n1 - n2 - x) + H);
+		const uint16_t dl = uint16_t(x > p1 ? x - p1 : p1 - x), dr = uint16_t(x > n1 ? x - n1 : n1 - x);
+		return uint16_t((el <= H2) | (er <= H2) | ((dl <= T) & (dr <= T)) | (p1 == 0) | (n1 == 0));
+	};
+	keep[0] = keep[1] = keep[cols - 2] = keep[cols - 1] = 0;
+	for (int c = 2; c < cols - 2; c++)
+	{
+		const uint16_t x = row[c];
+		keep[c] = uint8_t(
+			(calm(row[c - 2], row[c - 1], x, row[c + 1], row[c + 2]) & calm(u2[c], u1[c], x, d1[c], d2[c])) | (x == 0));
+	}
 }
 }  // namespace
 }  // namespace gam

@@ -52,6 +52,10 @@ struct ProjectionFilter
 	float z_min = -std::numeric_limits<float>::infinity();
 	float z_max = std::numeric_limits<float>::infinity();
 	int decimation = 1;  ///< use every n-th row and column
+	/** Drop flying pixels (the "mixed pixels" of ToF cameras at a depth edge,
+	 * whose depth lies between the two surfaces): see DepthProjector. Not in
+	 * the paper's method. */
+	bool drop_flying_pixels = true;
 
 	/** The .ini keys, shared by every map that projects depth frames. */
 	template <class Self, class Visit>
@@ -62,6 +66,9 @@ struct ProjectionFilter
 		visit(ParamInfo{"min_range", 0, 1e4, "closer sensor returns are dropped [m]"}, p.min_range);
 		visit(ParamInfo{"max_range", 0.01, 1e4, "farther sensor returns are dropped [m]"}, p.max_range);
 		visit(ParamInfo{"decimation", 1, 64, "use every n-th pixel row/column"}, p.decimation);
+		visit(
+			ParamInfo{"drop_flying_pixels", 0, 1, "drop the mixed pixels between the two sides of a depth edge"},
+			p.drop_flying_pixels);
 	}
 	/** Ranges, z_min < z_max and min_range < max_range; throws std::invalid_argument. */
 	void validate() const;
@@ -79,7 +86,9 @@ class DepthProjector
 {
    public:
 	/** Bins every valid pixel into `out` (appends). Pixels that are 0, beyond
-	 * the range limits, outside the grid or the z band are skipped.
+	 * the range limits, outside the grid or the z band are skipped, and with
+	 * f.drop_flying_pixels the flying pixels (isFlyingPixel, with a tolerance
+	 * of one grid cell).
 	 * Returns the number of pixels binned. Throws std::invalid_argument if the
 	 * image and the intrinsics disagree. */
 	size_t project(
@@ -104,6 +113,20 @@ class DepthProjector
 	const float* rayYRow(int row) const { return m_rayY.data() + size_t(row) * size_t(m_lutK.width); }
 	const float* rayZRow(int row) const { return m_rayZ.data() + size_t(row) * size_t(m_lutK.width); }
 
+	/** A flying pixel: along its row or its column (neighbours `step` pixels
+	 * apart), its depth d lies strictly between its two neighbours a and b,
+	 * more than `tol` from each, and it continues neither side's surface: on
+	 * a plane the inverse depth is affine in the pixel coordinates, so the
+	 * two pixels on each side predict it (1 / (2/a - 1/a2)); it is more than
+	 * `tol` from both predictions. Both sides of an edge can mix, so two
+	 * adjacent pixels within `tol` of each other are tested as one such pixel
+	 * too. A mixed pixel at a depth edge is flying; a floor seen at a grazing
+	 * angle (steep but affine in inverse depth), the wall of a hole
+	 * (continuous with its neighbour on the wall, or farther than both) and a
+	 * thin object (nearer than both neighbours) are not. Depths and `tol` in
+	 * the image's units; 0 = no return (a side with a 0 predicts nothing). */
+	static bool isFlyingPixel(const RangeImageView& img, int row, int col, int step, float tol);
+
 	/** Whether the AVX2 row loop can run here (CPU and build). */
 	static bool avx2Available();
 
@@ -116,6 +139,7 @@ class DepthProjector
 	// One row of results before compaction (cell or -1, z).
 	std::vector<int32_t> m_rowCell;
 	std::vector<float> m_rowZ;
+	std::vector<uint8_t> m_rowKeep;  // 0: a flying pixel
 	bool m_allowAvx2 = true;
 };
 
