@@ -848,8 +848,12 @@ bool RrtGroundDetector::joinsAcceptedPlane(
 {
 	// Between a patch node p and an accepted node q at most d_n apart (a tree
 	// step), the patch and q's plane Q meet if the patch's height over Q
-	// changes sign from p to q, or is within the noise band `tol` at either.
-	// Two such pairs (one can be a node whose window straddles an edge).
+	// changes sign from p to q, or is within the noise band `tol` at p, or
+	// at q within `tol` + the inlier distance of q's plane: q is that far
+	// off Q by definition (the foot of a ramp, up to 2.5 cm above the
+	// floor, holds ground-plane nodes that lie on the ramp). The lower level
+	// of a 5 cm step is further off. Two such pairs (one can be a node whose
+	// window straddles an edge).
 	const double link2 = m_params.expansion_distance * m_params.expansion_distance;
 	int joins = 0;
 	for (size_t a = begin; a < end; a++)
@@ -863,7 +867,8 @@ bool RrtGroundDetector::joinsAcceptedPlane(
 			const Plane& Q = out.planes[size_t(q.plane_id)];
 			const double atP = plane.heightAt(p.x, p.y) - Q.heightAt(p.x, p.y);
 			const double atQ = plane.heightAt(q.x, q.y) - Q.heightAt(q.x, q.y);
-			if (((atP > 0) != (atQ > 0) || std::min(std::abs(atP), std::abs(atQ)) <= tol) && ++joins >= 2) return true;
+			const double qBand = tol + (q.plane_id == 0 ? m_params.ransac_inlier_distance : tol);
+			if (((atP > 0) != (atQ > 0) || std::abs(atP) <= tol || std::abs(atQ) <= qBand) && ++joins >= 2) return true;
 		}
 	}
 	return false;
