@@ -155,12 +155,10 @@ bool flyingAt(const RangeImageView& img, int r, int c, int step, float tol)
 }
 
 // Marks the flying pixels of row r (every dec-th column) in keep[k] = 0.
-// A branch-free pass (it vectorizes) keeps every pixel that continues the
-// surface on one side along both lines through it, in depth: two pixels
-// a2, a predict 2a - a2, within tol / 2 (a plane's depth is affine in inverse
-// depth, not in depth; over three pixels the difference is a few mm at
-// most), or that is within tol of both neighbours of a side it fails.
-// The few others get the full test (flyingAt).
+// Inside the image (dec = 1) a vector pass (flyingCandidates, ProjectRow.h)
+// clears every pixel that cannot be flying; only the few candidates left get
+// the full test (flyingAt). Near the borders and with decimation, every
+// pixel gets the full test.
 void markFlyingRow(const RangeImageView& img, int r, int dec, float tol, bool avx2, uint8_t* keep)
 {
 	const int cols = img.cols, used = (cols + dec - 1) / dec;
