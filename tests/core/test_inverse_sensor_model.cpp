@@ -298,6 +298,148 @@ TEST(InverseSensorModel, ClassifyByTheMeanAgainstTheMeasuredFloorSpread)
 	EXPECT_EQ(ism.floorOffset(Eigen::Vector3d(0, 0, 1), 3, 0, 0), -1.0);
 }
 
+TEST(IsmFormulas, BinomialTailAndNormalTail)
+{
+	// P(X >= k), X ~ Binomial(n, p), by hand.
+	EXPECT_DOUBLE_EQ(ism::binomialTail(5, 0.3, 0), 1.0);
+	EXPECT_NEAR(ism::binomialTail(2, 0.5, 1), 0.75, 1e-15);  // 1 - 0.5^2
+	EXPECT_NEAR(ism::binomialTail(2, 0.5, 2), 0.25, 1e-15);
+	EXPECT_NEAR(ism::binomialTail(3, 0.1, 2), 0.028, 1e-15);  // 3 * 0.01 * 0.9 + 0.001
+	EXPECT_DOUBLE_EQ(ism::binomialTail(3, 0.1, 4), 0.0);      // k > n
+	EXPECT_DOUBLE_EQ(ism::binomialTail(30, 0.0, 1), 0.0);
+	// Standard normal tail (tables): P(Z < -3) = 0.0013499, P(Z < -2) = 0.0227501.
+	EXPECT_NEAR(ism::normalTail(3.0), 0.0013499, 1e-7);
+	EXPECT_NEAR(ism::normalTail(2.0), 0.0227501, 1e-7);
+	EXPECT_NEAR(ism::normalTail(0.0), 0.5, 1e-15);
+}
+
+namespace
+{
+// One cell at (1.025, 0.025) seen from (0, 0, 1) over the floor z = 0, the
+// noise model alone (nothing measured): the deep-sample threshold by hand.
+// r = |(1.025, 0.025, 0) - (0, 0, 1)| = sqrt(1.050625 + 0.000625 + 1) =
+// 1.432219 (the cells' means of a few mm below 0 move it by < 3 mm, which
+// moves T by < 0.01 mm); one sample's vertical noise sigma = (0.0012 +
+// 0.0019 r^2) / r = 0.0050974 / 1.432219 = 0.0035591; tau = d_pth / 3 = 0.01;
+// s = sqrt(sigma^2 + tau^2) = 0.0106145; T = max(0.02, 3 s) = 0.0318436.
+constexpr double kDeepX = 1.025, kDeepY = 0.025;
+double handDeepThreshold()
+{
+	const double r = std::sqrt(1.025 * 1.025 + 0.025 * 0.025 + 1.0);
+	const double sigma = (0.0012 + 0.0019 * r * r) / r;
+	return std::max(0.02, 3.0 * std::sqrt(sigma * sigma + 0.01 * 0.01));
+}
+IsmParams deepParams()
+{
+	IsmParams p;
+	p.measure_floor_noise = false;   // the model's sigma
+	p.measure_floor_offset = false;  // tau = d_pth / 3
+	return p;
+}
+/** A frame whose one cell holds `nFloor` samples at z = 0 and the `deep` ones. */
+ElevationGrid deepCellFrame(int nFloor, const std::vector<float>& deep, BinnedPoints& b, bool outlierFilter = false)
+{
+	ElevationGrid grid;
+	b.clear();
+	for (int i = 0; i < nFloor; i++) grid.binPoint(kDeepX, kDeepY, 0.f, b);
+	for (float z : deep) grid.binPoint(kDeepX, kDeepY, z, b);
+	OutlierFilterParams f;
+	f.enabled = outlierFilter;
+	grid.insert(b, f);
+	return grid;
+}
+}  // namespace
+
+TEST(InverseSensorModel, DeepSamplesBeyondTheFloorNoiseMakeADrop)
+{
+	// Issue #13 item 3: a hole's far wall puts many samples a little below the
+	// floor into a cell whose mean and z_min stay inside their bands.
+	const double T = handDeepThreshold();
+	ASSERT_NEAR(T, 0.0318436, 1e-6);
+	const float below = float(-T - 0.001), above = float(-T + 0.001);
+	InverseSensorModel ism(deepParams());
+	IsmStats st;
+	BinnedPoints b;
+	auto classOf = [&](const ElevationGrid& f, const BinnedPoints* samples) {
+		ism.compute(f, handDetection(kFloor), {0, 0, 1}, 5.0, st, samples);
+		return ism.classes()[f.geometry().index(f.geometry().ix(kDeepX), f.geometry().iy(kDeepY))];
+	};
+	// 27 floor samples and 3 at -3.28 cm. One-sample band: d_pth + 3 sigma =
+	// 0.03 + 0.0106772 = 0.0406772 > 0.0328; mean -0.00328, band of the mean
+	// 0.03 + 0.0106772 / sqrt(30) = 0.0319: floor by both. Deep samples: k = 3
+	// of n = 30 with p0 = P(Z < -3) = 0.0013499 (T = 3 s here); P(X >= 3) ~
+	// C(30, 3) p0^3 = 4060 * 2.4598e-9 = 1.0e-5 (exactly 0.97e-5) < 0.0013499: a drop.
+	const ElevationGrid three = deepCellFrame(27, {below, below, below}, b);
+	EXPECT_EQ(classOf(three, &b), VoxelClass::Drop);
+	EXPECT_EQ(st.deep_drops, 1u);
+	EXPECT_EQ(st.drop, 1u);
+	EXPECT_EQ(st.ground, 0u);
+	EXPECT_GT(ism.evidence()[three.geometry().index(three.geometry().ix(kDeepX), three.geometry().iy(kDeepY))], 0.5f);
+	EXPECT_NEAR(ism::binomialTail(30, ism::normalTail(3.0), 3), 1.0e-5, 0.1e-5);
+	// Without the frame's samples, or with the test off: z_min and mean only.
+	EXPECT_EQ(classOf(three, nullptr), VoxelClass::Ground);
+	IsmParams off = deepParams();
+	off.deep_sample_test = false;
+	InverseSensorModel noDeep(off);
+	noDeep.compute(three, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.ground, 1u);
+	EXPECT_EQ(st.deep_drops, 0u);
+
+	// 1 mm above -T the samples do not count.
+	const ElevationGrid shallow = deepCellFrame(27, {above, above, above}, b);
+	EXPECT_EQ(classOf(shallow, &b), VoxelClass::Ground);
+	// Two deep samples are fewer than drop_ray_min_points = 3 (a spike pair).
+	const ElevationGrid two = deepCellFrame(28, {below, below}, b);
+	EXPECT_EQ(classOf(two, &b), VoxelClass::Ground);
+}
+
+TEST(InverseSensorModel, DeepSampleCountIsJudgedAgainstTheCellsSampleCount)
+{
+	// The same 3 deep samples among n = 300: floor noise gives P(X >= 3) with
+	// p0 = 0.0013499: (1 - p0)^300 = exp(300 ln(1 - p0)) = 0.66685 = P(0),
+	// P(1) = 300 p0 / (1 - p0) P(0) = 0.27041, P(2) = 299/2 p0 / (1 - p0) P(1)
+	// = 0.054646; P(X >= 3) = 1 - 0.99191 = 0.0081 > 0.0013499: floor.
+	// Five: P(X >= 5) ~ 6e-5 (Poisson, lambda = 0.405): a drop.
+	EXPECT_NEAR(ism::binomialTail(300, ism::normalTail(3.0), 3), 0.0081, 0.0001);
+	const float below = float(-handDeepThreshold() - 0.001);
+	InverseSensorModel ism(deepParams());
+	IsmStats st;
+	BinnedPoints b;
+	const ElevationGrid three = deepCellFrame(297, std::vector<float>(3, below), b);
+	ism.compute(three, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 0u);
+	EXPECT_EQ(st.ground, 1u);
+	const ElevationGrid five = deepCellFrame(295, std::vector<float>(5, below), b);
+	ism.compute(five, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 1u);
+	EXPECT_EQ(st.drop, 1u);
+}
+
+TEST(InverseSensorModel, DeepSamplesRejectedByTheThreeSigmaRuleDoNotCount)
+{
+	// 60 floor samples, 2 at -T - 1 mm (about -0.0328) and 3 spikes at -0.3.
+	// 3-sigma rule over all 65: mean = (-0.0656 - 0.9) / 65 = -0.014855,
+	// E[z^2] = (2 * 0.0010787 + 3 * 0.09) / 65 = 0.0041870, var = 0.0041870 -
+	// 0.0002207 = 0.0039663, std 0.062979, band +-0.18894: the spikes (0.285
+	// from the mean) go, the two (0.018) stay. Counted: 2 < 3, floor; the 5
+	// of the unfiltered samples would have made it a drop.
+	const float below = float(-handDeepThreshold() - 0.001);
+	InverseSensorModel ism(deepParams());
+	IsmStats st;
+	BinnedPoints b;
+	const ElevationGrid f = deepCellFrame(60, {below, below, -0.3f, -0.3f, -0.3f}, b, true);
+	const ElevationCell& c = f.cell(f.geometry().index(f.geometry().ix(kDeepX), f.geometry().iy(kDeepY)));
+	ASSERT_EQ(c.count, 62u);
+	ASSERT_FLOAT_EQ(c.z_min, below);
+	ism.compute(f, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 0u);
+	EXPECT_EQ(st.ground, 1u);
+	// Control: the same 60 + 2 with a third sample at -T - 1 mm is a drop.
+	const ElevationGrid g3 = deepCellFrame(60, {below, below, below, -0.3f, -0.3f, -0.3f}, b, true);
+	ism.compute(g3, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 1u);
+}
+
 namespace
 {
 // Frame of test ISM-1 (grid -5..5 m, 5 cm). Sensor at (0, 0, 1), ground z = 0.

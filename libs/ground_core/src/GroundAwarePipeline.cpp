@@ -122,7 +122,7 @@ const FrameResult& GroundAwarePipeline::process(
 
 	// 3. Evidence.
 	m_result.sensor = frame.sensor_position;
-	m_ism.compute(m_grid, m_result.detection, m_result.sensor, m_params.projection.max_range, m_result.ism);
+	m_ism.compute(m_grid, m_result.detection, m_result.sensor, m_params.projection.max_range, m_result.ism, &m_bins);
 	const auto t4 = clk::now();
 
 	// 4. Missing floor: where the ground predicts a floor return and the

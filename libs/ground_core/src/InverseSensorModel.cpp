@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -20,6 +21,22 @@ double voxelDensity(uint32_t count, double span, double resolution)
 double densityConfidence(double rho, const IsmParams& p) { return 1.0 / (1.0 + std::exp(-(p.K_n * rho - p.d_min))); }
 double obstacleProbability(double pr, const IsmParams& p) { return 0.5 + 0.5 * p.K_m * pr; }
 double groundProbability(double d, const IsmParams& p) { return 0.5 - p.K_g * std::exp(-d * d / (2.0 * p.sigma2)); }
+double binomialTail(uint32_t n, double p, uint32_t k)
+{
+	if (k == 0) return 1.0;
+	if (k > n || !(p > 0)) return 0.0;
+	if (p >= 1) return 1.0;
+	// 1 - sum_{i<k} C(n,i) p^i (1-p)^(n-i), the terms by recurrence; the tail
+	// is compared with ~1e-3, far above the round-off of the sum.
+	double term = std::pow(1.0 - p, double(n)), below = 0;
+	const double ratio = p / (1.0 - p);
+	for (uint32_t i = 0; i < k; i++)
+	{
+		below += term;
+		term *= double(n - i) / double(i + 1) * ratio;
+	}
+	return std::max(0.0, 1.0 - below);
+}
 }  // namespace ism
 
 namespace paper
@@ -218,9 +235,43 @@ const Plane& InverseSensorModel::choosePlane(
 	return *best;
 }
 
+void InverseSensorModel::countDeepSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats)
+{
+	// One pass over the frame's samples: a candidate cell counts those below
+	// its threshold that the 3-sigma rule kept (the kept ones are exactly
+	// those in [z_min, z_max] of the cell).
+	const ConstSpan<uint32_t> cells = samples.cells();
+	const ConstSpan<float> zs = samples.heights();
+	const size_t nCells = m_deepZ.size();
+	for (size_t i = 0; i < cells.size(); i++)
+	{
+		const uint32_t c = cells[i];
+		if (c < nCells && zs[i] < m_deepZ[c] && zs[i] >= frame.cell(c).z_min) m_deepCount[c]++;
+	}
+	const double alpha = ism::normalTail(m_params.noise_sigmas);
+	const uint32_t kMin = uint32_t(std::max(1, m_params.drop_ray_min_points));
+	const double res = frame.geometry().resolution;
+	for (const DeepCandidate& d : m_deepCandidates)
+	{
+		const uint32_t k = m_deepCount[d.cell];
+		m_deepZ[d.cell] = -std::numeric_limits<float>::infinity();
+		m_deepCount[d.cell] = 0;
+		const ElevationCell& c = frame.cell(d.cell);
+		if (k < kMin || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
+		m_class[d.cell] = VoxelClass::Drop;
+		stats.ground--;
+		stats.drop++;
+		stats.deep_drops++;
+		const double rho = ism::voxelDensity(c.count, c.span(), res);
+		put(d.cell, float(ism::obstacleProbability(ism::densityConfidence(rho, m_params), m_params)));
+		if (m_params.drop_rays) m_dropVoxels.push_back(d.cell);
+	}
+	m_deepCandidates.clear();
+}
+
 void InverseSensorModel::compute(
 	const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, double maxRange,
-	IsmStats& stats)
+	IsmStats& stats, const BinnedPoints* samples)
 {
 	if (!(maxRange > 0) || !std::isfinite(maxRange))
 		throw std::invalid_argument("ISM: the sensor's max range must be > 0 (got " + std::to_string(maxRange) + ")");
@@ -243,6 +294,9 @@ void InverseSensorModel::compute(
 		m_noiseSorted.reserve(g.cellCount());
 		m_offsetValue.reserve(g.cellCount());
 		m_offsetSorted.reserve(g.cellCount());
+		m_deepCandidates.reserve(g.cellCount());
+		m_deepZ.assign(g.cellCount(), -std::numeric_limits<float>::infinity());
+		m_deepCount.assign(g.cellCount(), 0);
 	}
 	for (uint32_t c : m_evidenceCells) m_evidence[c] = 0.5f;
 	m_evidenceCells.clear();
@@ -261,6 +315,8 @@ void InverseSensorModel::compute(
 	measureFloorNoise(frame, det, sensor);
 	const double maxR2 = m_maxRange * m_maxRange;
 	const double res = g.resolution;
+	const bool deepTest = m_params.deep_sample_test && samples && !samples->empty() && m_params.noise_sigmas > 0;
+	m_deepCandidates.clear();
 
 	// Pass 1: every observed voxel updates its own cell.
 	for (uint32_t idx : frame.observedCells())
@@ -278,8 +334,24 @@ void InverseSensorModel::compute(
 			const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
 			const Plane& pl = choosePlane(det, c, x, y, block);
 			const double hs = pl.signedDistance(sensor.x(), sensor.y(), sensor.z());
-			cls = classify(
-				c, x, y, pl, groundBand(sensor, hs, x, y, c.mean()), dMean, floorOffset(sensor, x, y, c.mean()));
+			const double band = groundBand(sensor, hs, x, y, c.mean());
+			const double tau = floorOffset(sensor, x, y, c.mean());
+			cls = classify(c, x, y, pl, band, dMean, tau);
+			if (deepTest && cls == VoxelClass::Ground && c.count >= uint32_t(std::max(1, m_params.drop_ray_min_points)))
+			{
+				// Floor sample scatter around the plane: one sample's noise and
+				// the cells' offsets (d_pth as 3 sigma where not measured).
+				const double k = m_params.noise_sigmas, sigma = (band - m_params.d_pth) / k;
+				const double t = tau >= 0 ? tau : m_params.d_pth / k;
+				const double s = std::sqrt(sigma * sigma + t * t);
+				const double T = std::max(m_params.traversable_step, k * s);
+				if (s > 0 && pl.signedDistance(x, y, c.z_min) < -T && pl.c > 0)
+				{
+					// signedDistance = c (z - heightAt) for a unit normal.
+					m_deepZ[idx] = float(pl.heightAt(x, y) - T / pl.c);
+					m_deepCandidates.push_back({idx, float(ism::normalTail(T / s))});
+				}
+			}
 		}
 		m_class[idx] = cls;
 		m_classCells.push_back(idx);
@@ -310,6 +382,8 @@ void InverseSensorModel::compute(
 			case VoxelClass::None: break;
 		}
 	}
+
+	if (!m_deepCandidates.empty()) countDeepSamples(frame, *samples, stats);
 
 	// Pass 2: the ray to a below-ground voxel crossed the ground plane and went
 	// on below it; no floor stopped it in between. Mark those cells, unless

@@ -63,6 +63,20 @@ struct IsmParams
 	 * an uneven floor or a poor plane fit widens it by itself, up to the
 	 * d_pth form (never wider). Off: d_pth. */
 	bool measure_floor_offset = true;
+	/** Count the deep samples too (issue #13 item 3). At the far wall of a hole
+	 * one cell holds the floor behind the hole and the wall below it, which the
+	 * camera sees from 0 down to w h / r: the mean of the cell stays near the
+	 * floor and its deepest sample inside the one-sample band, yet dozens of
+	 * its samples lie deeper than any floor sample would. A floor sample lies
+	 * more than T = max(traversable_step, noise_sigmas * s) below the plane
+	 * with probability p0 = Phi(-T / s) (s^2 = sigma^2 + tau^2: one sample's
+	 * vertical noise and the measured spread of the cells' means, d_pth /
+	 * noise_sigmas where unmeasured); a cell whose k such samples (of the N
+	 * the 3-sigma rule kept) have P(Binomial(N, p0) >= k) < Phi(-noise_sigmas),
+	 * the false-alarm rate of the band itself, is a drop, if k >=
+	 * drop_ray_min_points (a depth spike is not a hole). Off: the cell's
+	 * z_min and mean only. */
+	bool deep_sample_test = true;
 	/** Bumps and dips smaller than this are floor for the robot: its wheels
 	 * cross them (the simulator's ground truth uses the same 2 cm). The band
 	 * of the mean never gets narrower. [m] */
@@ -117,6 +131,11 @@ struct IsmParams
 				"mean test: the plane error term from the floor cells' measured spread instead of d_pth"},
 			p.measure_floor_offset);
 		visit(
+			ParamInfo{
+				"deep_sample_test", 0, 1,
+				"a cell with more samples far below the plane than floor noise explains is a drop"},
+			p.deep_sample_test);
+		visit(
 			ParamInfo{"traversable_step", 0, 1, "bumps and dips smaller than this are floor for the robot [m]"},
 			p.traversable_step);
 		visit(
@@ -160,6 +179,11 @@ double obstacleProbability(double densityConfidence, const IsmParams& p);
 /** Eq. (6): P(occ) of a ground voxel at plane distance d. */
 double groundProbability(double d, const IsmParams& p);
 
+/** P(X >= k) for X ~ Binomial(n, p): the chance that floor noise alone puts
+ * k of a cell's n samples beyond the deep-sample threshold. */
+double binomialTail(uint32_t n, double p, uint32_t k);
+/** P(Z < -x) for a standard normal Z. */
+inline double normalTail(double x) { return 0.5 * std::erfc(x / std::sqrt(2.0)); }
 /** Combines two pieces of evidence for one cell within a frame: occupied
  * evidence wins (the largest one), otherwise the strongest free one. */
 inline float combine(float a, float b)
@@ -236,7 +260,8 @@ struct IsmStats
 	size_t ground = 0, obstacle = 0, drop = 0, overhead = 0, out_of_range = 0;
 	size_t sparse = 0;  ///< obstacle/drop voxels below min_obstacle_points: ignored
 	size_t drop_ray_cells = 0;
-	bool applied = false;  ///< false when there was no ground plane
+	size_t deep_drops = 0;  ///< drops found by the deep-sample count alone
+	bool applied = false;   ///< false when there was no ground plane
 };
 
 class InverseSensorModel
@@ -253,13 +278,15 @@ class InverseSensorModel
 	}
 	const IsmParams& params() const { return m_params; }
 
-	/** Computes the evidence of one frame. `sensor` is the sensor position in
+	/** Computes the evidence of one frame. `samples` are the heights the frame
+	 * was built from (for deep_sample_test; without them the test is skipped).
+	 * `sensor` is the sensor position in
 	 * the grid frame; voxels farther than `maxRange` from it (2D) are ignored.
 	 * With no ground plane (det.ok() false) nothing is produced: a frame
 	 * without ground never invents obstacles. */
 	void compute(
 		const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, double maxRange,
-		IsmStats& stats);
+		IsmStats& stats, const BinnedPoints* samples = nullptr);
 
 	/** P(occupied) per frame cell; 0.5 where there is no evidence. */
 	const std::vector<float>& evidence() const { return m_evidence; }
@@ -304,6 +331,9 @@ class InverseSensorModel
 	std::vector<uint32_t> m_paperCount;
 	const Plane& choosePlane(const GroundDetection& det, const ElevationCell& c, double x, double y, int block) const;
 	void buildSupport(const GridGeometry& g, const GroundDetection& det);
+	/** deep_sample_test: counts each candidate cell's kept samples below its
+	 * threshold, then turns the cells that pass into drops. */
+	void countDeepSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats);
 	void measureFloorNoise(const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor);
 
 	std::vector<float> m_floorNoise;   ///< per bin: measured std [m], < 0 = not measured
@@ -322,6 +352,16 @@ class InverseSensorModel
 	std::vector<VoxelClass> m_class;
 	std::vector<uint32_t> m_classCells;
 	std::vector<uint32_t> m_dropVoxels;
+	// deep_sample_test: per candidate cell its threshold height (-inf elsewhere),
+	// the count of kept samples below it, and p0.
+	struct DeepCandidate
+	{
+		uint32_t cell;
+		float p0;
+	};
+	std::vector<DeepCandidate> m_deepCandidates;
+	std::vector<float> m_deepZ;
+	std::vector<uint32_t> m_deepCount;
 	// Local-plane support raster: bit k set = plane k applies in that block.
 	std::vector<uint8_t> m_support;
 	int m_blockCells = 4, m_bnx = 0, m_bny = 0;
