@@ -298,6 +298,41 @@ TEST(GroundAwareGrid, LeddarScansDoNotOutvoteAHoleSeenLater)
 	EXPECT_GT(pOcc(g, 3.0, 0.0), 0.6) << "the Leddar's own hits still count";
 }
 
+TEST(GroundAwareGrid, LeddarScansTakeBackOnlyTheirOwnHits)
+{
+	// A wide beam's echo is drawn across its cone at the nearest range, so an
+	// arc can lie in front of the real surface. A later scan whose rays pass
+	// through such cells may take them back, but only up to unknown (a planar
+	// beam never makes floor free), and only cells no one but a scan marked.
+	auto fan = [](float range) {
+		mrpt::obs::CObservation2DRangeScan s;  // 181 beams over 90 deg: no upsampling
+		s.aperture = float(DEG2RAD(90.0));
+		s.rightToLeft = true;
+		s.maxRange = 50;
+		s.sensorPose = CPose3D(0, 0, 0.3, 0, 0, 0);
+		s.resizeScan(181);
+		for (size_t i = 0; i < 181; i++)
+		{
+			s.setScanRange(i, range);
+			s.setScanRangeValidity(i, true);
+		}
+		return s;
+	};
+	CGroundAwareOccupancyGrid g(-5, 5, -5, 5, 0.05f);
+	const int ux = g.x2idx(1.0f), uy = g.y2idx(1.0f);  // (1, 1): 1.41 m, inside both arcs
+	g.setCell(unsigned(ux), unsigned(uy), 0.1f);       // occupied, not by a scan
+	const float marked = g.getCell(unsigned(ux), unsigned(uy));
+	ASSERT_TRUE(g.insertObservation(fan(2.0f)));
+	ASSERT_GT(pOccNear(g, 2.0, 0.0), 0.6) << "the first scan's arc at 2 m";
+	for (int k = 0; k < 5; k++) ASSERT_TRUE(g.insertObservation(fan(4.0f)));
+	for (int dy = -1; dy <= 1; dy++)
+		for (int dx = -1; dx <= 1; dx++)
+			EXPECT_NEAR(pOcc(g, 2.0 + 0.05 * dx, 0.05 * dy), 0.5, 1e-3) << "taken back to unknown, not to free";
+	EXPECT_NEAR(pOcc(g, 1.0, 0.0), 0.5, 1e-3) << "never seen occupied: a planar beam frees nothing";
+	EXPECT_GT(pOccNear(g, 4.0, 0.0), 0.6) << "the second scan's arc";
+	EXPECT_FLOAT_EQ(g.getCell(unsigned(ux), unsigned(uy)), marked) << "not a scan's hit: kept";
+}
+
 TEST(GroundAwareGrid, MalformedObservationsThrowClearErrors)
 {
 	auto obs = testscene::renderDepth(holeAndBoxScene(), kKinect);

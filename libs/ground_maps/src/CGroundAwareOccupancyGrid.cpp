@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -256,6 +257,11 @@ bool CGroundAwareOccupancyGrid::insert2D(
 	// drove cells seen as floor from afar -- where a pit's visible part is
 	// shallower than the ground band -- to the log-odds clamp, and the drop
 	// seen later from close by could no longer mark them: issue #17.)
+	// One exception: a cell that only scans made occupied may be taken back
+	// by a later scan, up to unknown. A wide beam's echo is the nearest return
+	// in its cone and is drawn across the whole cone, up to 10 cm in front of
+	// a wall seen at an angle from 5 m; the beams that later pass through
+	// those cells undo that, and nothing the camera saw is touched.
 	const std::vector<cellType> before = m_map;
 	const double scanTime = rawScan.timestamp == INVALID_TIMESTAMP ? 0.0 : mrpt::Clock::toDouble(rawScan.timestamp);
 	const float x0 = getXMin(), y0 = getYMin();
@@ -265,14 +271,21 @@ bool CGroundAwareOccupancyGrid::insert2D(
 	// The grid may have grown (cell alignment is kept): shift the old indices.
 	const int ox = int(std::lround((x0 - getXMin()) / getResolution()));
 	const int oy = int(std::lround((y0 - getYMin()) / getResolution()));
+	syncLayer(m_scanOnlyLayer);
+	cellType* scanOnly = m_scanOnlyLayer.getRow(0);
+	const cellType kScanOnly = std::numeric_limits<cellType>::min();
 	for (int cy = 0; cy < sy0; cy++)
 		for (int cx = 0; cx < sx0; cx++)
 		{
 			const cellType old = before[size_t(cy) * size_t(sx0) + size_t(cx)];
 			const int nx = cx + ox, ny = cy + oy;
 			if (nx < 0 || ny < 0 || nx >= sx || ny >= sy) continue;
-			cellType& now = m_map[size_t(ny) * size_t(sx) + size_t(nx)];
-			if (now > old) now = old;
+			const size_t i = size_t(ny) * size_t(sx) + size_t(nx);
+			cellType& now = m_map[i];
+			if (now > old)
+				now = scanOnly[i] == kScanOnly ? std::max(old, std::min<cellType>(now, 0)) : old;
+			else if (now < old && old >= 0)
+				scanOnly[i] = kScanOnly;  // this scan made it occupied
 			if (m_options.obstacle_decay_s > 0 && now < old) notePositive(nx, ny, scanTime);
 		}
 	if (m_options.obstacle_decay_s > 0 && scanTime > 0) decayObstacles(scanTime);
@@ -360,9 +373,10 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 	return true;
 }
 
-void CGroundAwareOccupancyGrid::syncMissingLayer() const
+void CGroundAwareOccupancyGrid::syncMissingLayer() const { syncLayer(m_missingLayer); }
+
+void CGroundAwareOccupancyGrid::syncLayer(COccupancyGridMap2D& L) const
 {
-	COccupancyGridMap2D& L = m_missingLayer;
 	if (L.getSizeX() == getSizeX() && L.getSizeY() == getSizeY() && L.getXMin() == getXMin() &&
 		L.getYMin() == getYMin() && L.getResolution() == getResolution())
 		return;
@@ -480,12 +494,16 @@ void CGroundAwareOccupancyGrid::applyEvidence()
 	// (eq. 5 at full density confidence), combined with the ISM's.
 	const float pMissing = float(0.5 + 0.5 * m_options.pipeline.ism.K_m);
 	const int sx = int(getSizeX()), sy = int(getSizeY());
+	syncLayer(m_scanOnlyLayer);
+	cellType* scanOnly = m_scanOnlyLayer.getRow(0);
 	const auto update = [&](uint32_t c, float pOcc) {
 		const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
 		const int wx = x2idx(g.cx(cx)), wy = y2idx(g.cy(cy));
 		if (wx < 0 || wy < 0 || wx >= sx || wy >= sy) return;
 		const float pFree = std::clamp(1.0f - pOcc, gam::ism::kEvidenceFloor, 1.0f - gam::ism::kEvidenceFloor);
 		const int l = int(p2l(pFree));
+		// What the camera marks, no 2D scan takes back.
+		if (pOcc > 0.5f) scanOnly[size_t(wx) + size_t(wy) * getSizeX()] = 0;
 		cellType& cell = m_map[size_t(wx) + size_t(wy) * getSizeX()];
 		cell = cellType(std::clamp(int(cell) + l, int(OCCGRID_CELLTYPE_MIN), int(OCCGRID_CELLTYPE_MAX)));
 	};

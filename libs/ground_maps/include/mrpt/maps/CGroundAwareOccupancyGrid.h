@@ -171,6 +171,8 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	void applyEvidence();
 	/** Gives the missing-floor layer this grid's geometry (cells kept). */
 	void syncMissingLayer() const;
+	/** Gives a layer this grid's geometry, keeping the cells both cover. */
+	void syncLayer(COccupancyGridMap2D& layer) const;
 	/** obstacle_decay_s: records positive obstacle cells seen at time `t`,
 	 * forgets negative ones, and returns to unknown the positive ones older
 	 * than the decay time. */
@@ -186,6 +188,10 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	std::map<std::string, gam::MountMonitor> m_mounts;  // not serialized: state of a run
 	std::string m_lastSensorLabel;
 	mutable COccupancyGridMap2D m_missingLayer;
+	// Cells that only 2D scans made occupied (lowest cell value; anything else
+	// = the camera's or unknown provenance, which scans never free). State of
+	// a run: not serialized, so a loaded map's obstacles all stay.
+	COccupancyGridMap2D m_scanOnlyLayer;
 	// obstacle_decay_s: last time each positive obstacle cell was seen as one,
 	// keyed by its world cell (stable when the grid grows). Not serialized.
 	std::unordered_map<int64_t, double> m_positiveSeen;
