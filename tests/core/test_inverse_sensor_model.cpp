@@ -440,6 +440,44 @@ TEST(InverseSensorModel, DeepSamplesRejectedByTheThreeSigmaRuleDoNotCount)
 	EXPECT_EQ(st.deep_drops, 1u);
 }
 
+TEST(InverseSensorModel, ASpikeAmongFloorSamplesIsNoObstacle)
+{
+	// A cell of 20 floor samples and spikes at +0.3 m (or -0.3 m), no 3-sigma
+	// rule: its top (bottom) is far beyond the band (0.0407, see
+	// handDeepThreshold), so the cell is an obstacle (drop) by z_max (z_min).
+	// With the frame's samples it counts only if min_obstacle_points = 2 of
+	// them lie beyond the band; a drop ray needs drop_ray_min_points = 3.
+	InverseSensorModel ism(deepParams());
+	IsmStats st;
+	BinnedPoints b;
+	const ElevationGrid one = deepCellFrame(20, {0.3f}, b);
+	const uint32_t cell = uint32_t(one.geometry().index(one.geometry().ix(kDeepX), one.geometry().iy(kDeepY)));
+	ism.compute(one, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(ism.classes()[cell], VoxelClass::Obstacle);
+	EXPECT_EQ(st.sparse, 1u);
+	EXPECT_EQ(st.obstacle, 0u);
+	EXPECT_EQ(ism.evidence()[cell], 0.5f) << "one spike: no evidence";
+	ism.compute(one, handDetection(kFloor), {0, 0, 1}, 5.0, st, nullptr);
+	EXPECT_EQ(st.obstacle, 1u) << "without the samples: the cell count (21) decides";
+	const ElevationGrid two = deepCellFrame(20, {0.3f, 0.31f}, b);
+	ism.compute(two, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.obstacle, 1u);
+	EXPECT_GT(ism.evidence()[cell], 0.5f);
+
+	const ElevationGrid down2 = deepCellFrame(20, {-0.3f, -0.31f}, b);
+	ism.compute(down2, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.drop, 1u);
+	EXPECT_EQ(st.drop_ray_cells, 0u) << "two samples below: evidence, no ray";
+	const ElevationGrid down1 = deepCellFrame(20, {-0.3f}, b);
+	ism.compute(down1, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.drop, 0u);
+	EXPECT_EQ(st.sparse, 1u);
+	const ElevationGrid down3 = deepCellFrame(20, {-0.3f, -0.31f, -0.32f}, b);
+	ism.compute(down3, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.drop, 1u);
+	EXPECT_GT(st.drop_ray_cells, 0u) << "three below: the ray is cast";
+}
+
 namespace
 {
 // Frame of test ISM-1 (grid -5..5 m, 5 cm). Sensor at (0, 0, 1), ground z = 0.
@@ -719,6 +757,52 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 		}
 	}
 	EXPECT_NEAR(ism.evidence()[g.index(g.ix(3.0), g.iy(0.0))], pDrop, 1e-6);
+}
+
+TEST(InverseSensorModel, DropRayIsNotCastThroughAnObstacle)
+{
+	// Sensor at (0, 0, 1) over the floor z = 0, floor seen on x 0.5-2.0. Drop
+	// voxels at x 3.10-3.15 (cell centre 3.125), 4 samples at -0.10: the
+	// deepest sample's ray crosses the floor at t = 1 / 1.1, x = 3.125 / 1.1 =
+	// 2.841, and would paint the unseen cells 2.85-3.10. With a box at x
+	// 2.0-2.2 between, the ray passes over it at height 1 - 2.2 / 2.841 = 0.226
+	// (its far edge, the first cell seen walking back from the crossing): a
+	// 0.5 m box stops it (the crossing is in its shadow, where no sensor
+	// looked), a 0.1 m box does not.
+	auto frameWith = [](double boxTop) {
+		ElevationGrid grid;
+		std::mt19937 rng(1);
+		BinnedPoints b;
+		auto zero = [](double, double) { return 0.0; };
+		gamtest::sampleSurfaceIf(
+			grid, [&](double x, double y) { return inRect(x, y, 0.5, 2.0, -0.5, 0.5); }, zero, 2, 0.0, rng, b);
+		if (boxTop > 0) gamtest::sampleColumns(grid, 2.0, 2.2, -0.5, 0.5, 0.0, boxTop, boxTop / 4, b);
+		gamtest::sampleSurfaceIf(
+			grid, [](double x, double y) { return inRect(x, y, 3.1, 3.15, -0.1, 0.1); },
+			[](double, double) { return -0.1; }, 2, 0.0, rng, b);
+		gamtest::insertAll(grid, b);
+		return grid;
+	};
+	InverseSensorModel ism;
+	IsmStats st;
+	for (double boxTop : {0.0, 0.1})
+	{
+		const ElevationGrid f = frameWith(boxTop);
+		const GridGeometry& g = f.geometry();
+		ism.compute(f, handDetection(kFloor), {0, 0, 1}, 5.0, st);
+		ASSERT_EQ(st.drop, 4u) << boxTop;
+		EXPECT_EQ(st.drop_rays_unsupported, 0u) << boxTop;
+		EXPECT_GT(st.drop_ray_cells, 0u) << boxTop;
+		EXPECT_GT(ism.evidence()[g.index(g.ix(2.875), g.iy(0.025))], 0.5f) << boxTop;
+		EXPECT_GT(ism.evidence()[g.index(g.ix(3.025), g.iy(0.025))], 0.5f) << boxTop;
+	}
+	const ElevationGrid shadow = frameWith(0.5);
+	const GridGeometry& g = shadow.geometry();
+	ism.compute(shadow, handDetection(kFloor), {0, 0, 1}, 5.0, st);
+	ASSERT_EQ(st.drop, 4u);
+	EXPECT_EQ(st.drop_rays_unsupported, 4u);
+	EXPECT_EQ(st.drop_ray_cells, 0u);
+	for (double x = 2.825; x < 3.1; x += 0.05) EXPECT_EQ(ism.evidence()[g.index(g.ix(x), g.iy(0.025))], 0.5f) << x;
 }
 
 TEST(InverseSensorModel, DropRayMinPoints)

@@ -235,38 +235,86 @@ const Plane& InverseSensorModel::choosePlane(
 	return *best;
 }
 
-void InverseSensorModel::countDeepSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats)
+bool InverseSensorModel::rayBlocked(
+	const ElevationGrid& frame, const Plane& pl, const Eigen::Vector3d& sensor, double hs, double ex, double ey) const
 {
-	// One pass over the frame's samples: a candidate cell counts those below
-	// its threshold that the 3-sigma rule kept (the kept ones are exactly
-	// those in [z_min, z_max] of the cell).
+	// Walk back from the crossing (ex, ey) towards the sensor, half a cell at a
+	// time, to the first cell this frame observed: the ray passed over it at
+	// height hs (1 - rho / rhoC) above the plane (rho: 2D distance from the
+	// sensor). An obstacle there whose top reaches that height stopped it.
+	const GridGeometry& g = frame.geometry();
+	const double dx = ex - sensor.x(), dy = ey - sensor.y();
+	const double rhoC = std::sqrt(dx * dx + dy * dy);
+	if (!(rhoC > 0)) return false;
+	const int steps = int(rhoC / (0.5 * g.resolution));
+	for (int k = 0; k < steps; k++)
+	{
+		const double f = 1.0 - double(k) / steps;  // rho / rhoC
+		const double x = sensor.x() + f * dx, y = sensor.y() + f * dy;
+		const int cx = g.ix(x), cy = g.iy(y);
+		if (!g.inside(cx, cy)) continue;
+		const VoxelClass c = m_class[g.index(cx, cy)];
+		if (c == VoxelClass::None) continue;
+		if (c != VoxelClass::Obstacle) return false;
+		return pl.signedDistance(x, y, frame.cell(g.index(cx, cy)).z_max) >= hs * (1.0 - f);
+	}
+	return false;
+}
+
+void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats)
+{
+	// One pass over the frame's samples: each candidate cell counts those
+	// below its low threshold or above its high one that the 3-sigma rule
+	// kept (the kept ones are exactly those in [z_min, z_max] of the cell).
 	const ConstSpan<uint32_t> cells = samples.cells();
 	const ConstSpan<float> zs = samples.heights();
-	const size_t nCells = m_deepZ.size();
+	const size_t nCells = m_tailLo.size();
 	for (size_t i = 0; i < cells.size(); i++)
 	{
 		const uint32_t c = cells[i];
-		if (c < nCells && zs[i] < m_deepZ[c] && zs[i] >= frame.cell(c).z_min) m_deepCount[c]++;
+		if (c >= nCells) continue;
+		const float z = zs[i];
+		if ((z < m_tailLo[c] && z >= frame.cell(c).z_min) || (z > m_tailHi[c] && z <= frame.cell(c).z_max))
+			m_tailCount[c]++;
 	}
 	const double alpha = ism::normalTail(m_params.noise_sigmas);
-	const uint32_t kMin = uint32_t(std::max(1, m_params.drop_ray_min_points));
+	const uint32_t minPoints = uint32_t(std::max(1, m_params.min_obstacle_points));
+	const uint32_t minRay = uint32_t(std::max(1, m_params.drop_ray_min_points));
 	const double res = frame.geometry().resolution;
-	for (const DeepCandidate& d : m_deepCandidates)
+	for (const TailCandidate& d : m_tailCandidates)
 	{
-		const uint32_t k = m_deepCount[d.cell];
-		m_deepZ[d.cell] = -std::numeric_limits<float>::infinity();
-		m_deepCount[d.cell] = 0;
+		const uint32_t k = m_tailCount[d.cell];
+		m_tailLo[d.cell] = -std::numeric_limits<float>::infinity();
+		m_tailHi[d.cell] = std::numeric_limits<float>::infinity();
+		m_tailCount[d.cell] = 0;
 		const ElevationCell& c = frame.cell(d.cell);
-		if (k < kMin || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
-		m_class[d.cell] = VoxelClass::Drop;
-		stats.ground--;
-		stats.drop++;
-		stats.deep_drops++;
-		const double rho = ism::voxelDensity(c.count, c.span(), res);
-		put(d.cell, float(ism::obstacleProbability(ism::densityConfidence(rho, m_params), m_params)));
-		if (m_params.drop_rays) m_dropVoxels.push_back(d.cell);
+		const float pOcc = float(ism::obstacleProbability(
+			ism::densityConfidence(ism::voxelDensity(c.count, c.span(), res), m_params), m_params));
+		if (d.kind == TailKind::Deep)
+		{
+			if (k < minRay || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
+			m_class[d.cell] = VoxelClass::Drop;
+			stats.ground--;
+			stats.drop++;
+			stats.deep_drops++;
+			put(d.cell, pOcc);
+			if (m_params.drop_rays) m_dropVoxels.push_back(d.cell);
+			continue;
+		}
+		// An obstacle or a drop judged by its extreme sample: it takes as many
+		// samples beyond the band as any other (a lone spike among floor
+		// samples is no obstacle, and casts no ray).
+		if (k < minPoints)
+		{
+			stats.sparse++;
+			continue;
+		}
+		const bool drop = d.kind == TailKind::Below;
+		(drop ? stats.drop : stats.obstacle)++;
+		put(d.cell, pOcc);
+		if (drop && m_params.drop_rays && k >= minRay) m_dropVoxels.push_back(d.cell);
 	}
-	m_deepCandidates.clear();
+	m_tailCandidates.clear();
 }
 
 void InverseSensorModel::compute(
@@ -294,9 +342,10 @@ void InverseSensorModel::compute(
 		m_noiseSorted.reserve(g.cellCount());
 		m_offsetValue.reserve(g.cellCount());
 		m_offsetSorted.reserve(g.cellCount());
-		m_deepCandidates.reserve(g.cellCount());
-		m_deepZ.assign(g.cellCount(), -std::numeric_limits<float>::infinity());
-		m_deepCount.assign(g.cellCount(), 0);
+		m_tailCandidates.reserve(g.cellCount());
+		m_tailLo.assign(g.cellCount(), -std::numeric_limits<float>::infinity());
+		m_tailHi.assign(g.cellCount(), std::numeric_limits<float>::infinity());
+		m_tailCount.assign(g.cellCount(), 0);
 	}
 	for (uint32_t c : m_evidenceCells) m_evidence[c] = 0.5f;
 	m_evidenceCells.clear();
@@ -315,8 +364,9 @@ void InverseSensorModel::compute(
 	measureFloorNoise(frame, det, sensor);
 	const double maxR2 = m_maxRange * m_maxRange;
 	const double res = g.resolution;
-	const bool deepTest = m_params.deep_sample_test && samples && !samples->empty() && m_params.noise_sigmas > 0;
-	m_deepCandidates.clear();
+	const bool haveSamples = samples && !samples->empty();
+	const bool deepTest = m_params.deep_sample_test && haveSamples && m_params.noise_sigmas > 0;
+	m_tailCandidates.clear();
 
 	// Pass 1: every observed voxel updates its own cell.
 	for (uint32_t idx : frame.observedCells())
@@ -337,6 +387,23 @@ void InverseSensorModel::compute(
 			const double band = groundBand(sensor, hs, x, y, c.mean());
 			const double tau = floorOffset(sensor, x, y, c.mean());
 			cls = classify(c, x, y, pl, band, dMean, tau);
+			if (haveSamples && pl.c > 0 && (cls == VoxelClass::Obstacle || cls == VoxelClass::Drop) &&
+				c.count >= uint32_t(std::max(1, m_params.min_obstacle_points)))
+			{
+				// Judged by its top (bottom) sample while others lie in the band:
+				// count the samples beyond the band before it counts.
+				const double top = pl.signedDistance(x, y, c.z_max), bottom = pl.signedDistance(x, y, c.z_min);
+				if (cls == VoxelClass::Obstacle && top > band && bottom <= band)
+				{
+					m_tailHi[idx] = float(pl.heightAt(x, y) + band / pl.c);
+					m_tailCandidates.push_back({idx, TailKind::Above, 0.f});
+				}
+				else if (cls == VoxelClass::Drop && bottom < -band && top >= -band)
+				{
+					m_tailLo[idx] = float(pl.heightAt(x, y) - band / pl.c);
+					m_tailCandidates.push_back({idx, TailKind::Below, 0.f});
+				}
+			}
 			if (deepTest && cls == VoxelClass::Ground && c.count >= uint32_t(std::max(1, m_params.drop_ray_min_points)))
 			{
 				// Floor sample scatter around the plane: one sample's noise and
@@ -348,8 +415,8 @@ void InverseSensorModel::compute(
 				if (s > 0 && pl.signedDistance(x, y, c.z_min) < -T && pl.c > 0)
 				{
 					// signedDistance = c (z - heightAt) for a unit normal.
-					m_deepZ[idx] = float(pl.heightAt(x, y) - T / pl.c);
-					m_deepCandidates.push_back({idx, float(ism::normalTail(T / s))});
+					m_tailLo[idx] = float(pl.heightAt(x, y) - T / pl.c);
+					m_tailCandidates.push_back({idx, TailKind::Deep, float(ism::normalTail(T / s))});
 				}
 			}
 		}
@@ -369,6 +436,8 @@ void InverseSensorModel::compute(
 					stats.sparse++;
 					break;
 				}
+				// Decided once its samples beyond the band are counted.
+				if (!m_tailCandidates.empty() && m_tailCandidates.back().cell == idx) break;
 				(cls == VoxelClass::Drop ? stats.drop : stats.obstacle)++;
 				const double rho = ism::voxelDensity(c.count, c.span(), res);
 				put(idx, float(ism::obstacleProbability(ism::densityConfidence(rho, m_params), m_params)));
@@ -383,7 +452,7 @@ void InverseSensorModel::compute(
 		}
 	}
 
-	if (!m_deepCandidates.empty()) countDeepSamples(frame, *samples, stats);
+	if (!m_tailCandidates.empty()) countTailSamples(frame, *samples, stats);
 
 	// Pass 2: the ray to a below-ground voxel crossed the ground plane and went
 	// on below it; no floor stopped it in between. Mark those cells, unless
@@ -405,6 +474,15 @@ void InverseSensorModel::compute(
 		double lx = x - ex, ly = y - ey;
 		double len = std::sqrt(lx * lx + ly * ly);
 		if (len < res) continue;
+		// The ray got to the crossing only if nothing stood in its way. The
+		// sample (its cell's centre and z_min) may put the crossing in the
+		// shadow of a box, which no ray reached: then the cells would be
+		// painted where no sensor looked.
+		if (rayBlocked(frame, pl, sensor, hs, ex, ey))
+		{
+			stats.drop_rays_unsupported++;
+			continue;
+		}
 		if (len > m_params.max_drop_ray_length)
 		{
 			// Keep the part next to the voxel: far from it the plane estimate is

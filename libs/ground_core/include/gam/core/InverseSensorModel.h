@@ -84,7 +84,10 @@ struct IsmParams
 	/** Obstacle and drop voxels with fewer samples give no evidence. Any real
 	 * surface within a depth camera's range fills a d_r cell with several
 	 * samples (a 5 cm cell of floor 4.5 m away from a 512x424 Kinect One
-	 * 1 m up still gets ~4), a single depth spike or flying pixel only one. */
+	 * 1 m up still gets ~4), a single depth spike or flying pixel only one.
+	 * A voxel judged by its top (bottom) sample while others lie in the band
+	 * needs this many samples beyond the band (given the frame's samples):
+	 * a spike among floor samples is no obstacle. */
 	int min_obstacle_points = 2;
 	/** Voxels whose bottom is more than this above the ground do not block
 	 * (ceiling, door frames, beams above the robot). [m] */
@@ -93,9 +96,10 @@ struct IsmParams
 	 * ray crossed the ground plane and the voxel: no floor was there. */
 	bool drop_rays = true;
 	double max_drop_ray_length = 2.0;  ///< [m]
-	/** A drop voxel casts its ray only with at least this many samples: one
-	 * stray return (a depth spike, a reflection metres below the floor) must
-	 * not paint a line of obstacles across the floor. */
+	/** A drop voxel casts its ray only with at least this many samples (below
+	 * the band, for a voxel judged by its bottom sample): one stray return (a
+	 * depth spike, a reflection metres below the floor) must not paint a line
+	 * of obstacles across the floor. */
 	int drop_ray_min_points = 3;
 	/** Use the tree's extra ground patches (ramps) near their nodes. */
 	bool local_planes = true;
@@ -260,8 +264,9 @@ struct IsmStats
 	size_t ground = 0, obstacle = 0, drop = 0, overhead = 0, out_of_range = 0;
 	size_t sparse = 0;  ///< obstacle/drop voxels below min_obstacle_points: ignored
 	size_t drop_ray_cells = 0;
-	size_t deep_drops = 0;  ///< drops found by the deep-sample count alone
-	bool applied = false;   ///< false when there was no ground plane
+	size_t drop_rays_unsupported = 0;  ///< drop rays not cast: an obstacle stood between the sensor and the crossing
+	size_t deep_drops = 0;             ///< drops found by the deep-sample count alone
+	bool applied = false;              ///< false when there was no ground plane
 };
 
 class InverseSensorModel
@@ -333,7 +338,17 @@ class InverseSensorModel
 	void buildSupport(const GridGeometry& g, const GroundDetection& det);
 	/** deep_sample_test: counts each candidate cell's kept samples below its
 	 * threshold, then turns the cells that pass into drops. */
-	void countDeepSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats);
+	/** Whether the nearest cell this frame observed between the sensor and a
+	 * drop ray's crossing with the ground (ex, ey) is an obstacle tall enough
+	 * to have stopped that ray (hs: the sensor's height over `pl`). */
+	bool rayBlocked(
+		const ElevationGrid& frame, const Plane& pl, const Eigen::Vector3d& sensor, double hs, double ex,
+		double ey) const;
+	/** Counts each candidate cell's kept samples beyond its threshold, then
+	 * decides it: deep_sample_test (a floor cell becomes a drop), or an
+	 * obstacle / drop judged by its extreme sample (min_obstacle_points of
+	 * them beyond the band give evidence, drop_ray_min_points cast a ray). */
+	void countTailSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats);
 	void measureFloorNoise(const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor);
 
 	std::vector<float> m_floorNoise;   ///< per bin: measured std [m], < 0 = not measured
@@ -352,16 +367,24 @@ class InverseSensorModel
 	std::vector<VoxelClass> m_class;
 	std::vector<uint32_t> m_classCells;
 	std::vector<uint32_t> m_dropVoxels;
-	// deep_sample_test: per candidate cell its threshold height (-inf elsewhere),
-	// the count of kept samples below it, and p0.
-	struct DeepCandidate
+	// Cells decided by counting samples: per cell a low threshold height
+	// (samples below count; -inf elsewhere) or a high one (+inf elsewhere),
+	// the count, and p0 of the deep-sample test.
+	enum class TailKind : uint8_t
+	{
+		Deep,   ///< deep_sample_test on a ground cell
+		Above,  ///< obstacle by its top sample
+		Below   ///< drop by its bottom sample
+	};
+	struct TailCandidate
 	{
 		uint32_t cell;
+		TailKind kind;
 		float p0;
 	};
-	std::vector<DeepCandidate> m_deepCandidates;
-	std::vector<float> m_deepZ;
-	std::vector<uint32_t> m_deepCount;
+	std::vector<TailCandidate> m_tailCandidates;
+	std::vector<float> m_tailLo, m_tailHi;
+	std::vector<uint32_t> m_tailCount;
 	// Local-plane support raster: bit k set = plane k applies in that block.
 	std::vector<uint8_t> m_support;
 	int m_blockCells = 4, m_bnx = 0, m_bny = 0;
