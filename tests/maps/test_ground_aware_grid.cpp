@@ -36,20 +36,27 @@ double pOccNear(const COccupancyGridMap2D& g, double x, double y)
 	return p;
 }
 
+// A level planar scan of `beams` valid beams over `apertureDeg`, 50 m max range.
+mrpt::obs::CObservation2DRangeScan planarScan(double apertureDeg, size_t beams, const CPose3D& sensorPose)
+{
+	mrpt::obs::CObservation2DRangeScan s;
+	s.aperture = float(DEG2RAD(apertureDeg));
+	s.rightToLeft = true;
+	s.maxRange = 50;
+	s.sensorPose = sensorPose;
+	s.resizeScan(beams);
+	for (size_t i = 0; i < beams; i++) s.setScanRangeValidity(i, true);
+	return s;
+}
+
 // A Leddar IS16 (16 segments over 45 deg) 0.3 m up, seeing a wall 3 m ahead.
 mrpt::obs::CObservation2DRangeScan leddarWallScan()
 {
-	mrpt::obs::CObservation2DRangeScan s;
-	s.aperture = float(DEG2RAD(45.0));
-	s.rightToLeft = true;
-	s.maxRange = 50;
-	s.sensorPose = CPose3D(0.2, 0, 0.3, 0, 0, 0);
-	s.resizeScan(16);
+	auto s = planarScan(45.0, 16, CPose3D(0.2, 0, 0.3, 0, 0, 0));
 	for (size_t i = 0; i < 16; i++)
 	{
 		const double a = -s.aperture / 2 + (i + 0.5) * s.aperture / 16;
 		s.setScanRange(i, float(2.8 / std::cos(a)));  // wall at x = 3.0 in the robot frame
-		s.setScanRangeValidity(i, true);
 	}
 	return s;
 }
@@ -305,17 +312,8 @@ TEST(GroundAwareGrid, LeddarScansTakeBackOnlyTheirOwnHits)
 	// through such cells may take them back, but only up to unknown (a planar
 	// beam never makes floor free), and only cells no one but a scan marked.
 	auto fan = [](float range) {
-		mrpt::obs::CObservation2DRangeScan s;  // 181 beams over 90 deg: no upsampling
-		s.aperture = float(DEG2RAD(90.0));
-		s.rightToLeft = true;
-		s.maxRange = 50;
-		s.sensorPose = CPose3D(0, 0, 0.3, 0, 0, 0);
-		s.resizeScan(181);
-		for (size_t i = 0; i < 181; i++)
-		{
-			s.setScanRange(i, range);
-			s.setScanRangeValidity(i, true);
-		}
+		auto s = planarScan(90.0, 181, CPose3D(0, 0, 0.3, 0, 0, 0));  // 181 beams: no upsampling
+		for (size_t i = 0; i < 181; i++) s.setScanRange(i, range);
 		return s;
 	};
 	CGroundAwareOccupancyGrid g(-5, 5, -5, 5, 0.05f);

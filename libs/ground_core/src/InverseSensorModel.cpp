@@ -235,6 +235,12 @@ const Plane& InverseSensorModel::choosePlane(
 	return *best;
 }
 
+float InverseSensorModel::obstacleEvidence(const ElevationCell& c, double resolution) const
+{
+	const double rho = ism::voxelDensity(c.count, c.span(), resolution);
+	return float(ism::obstacleProbability(ism::densityConfidence(rho, m_params), m_params));
+}
+
 bool InverseSensorModel::rayBlocked(
 	const ElevationGrid& frame, const Plane& pl, const Eigen::Vector3d& sensor, double hs, double ex, double ey) const
 {
@@ -288,8 +294,7 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 		m_tailHi[d.cell] = std::numeric_limits<float>::infinity();
 		m_tailCount[d.cell] = 0;
 		const ElevationCell& c = frame.cell(d.cell);
-		const float pOcc = float(ism::obstacleProbability(
-			ism::densityConfidence(ism::voxelDensity(c.count, c.span(), res), m_params), m_params));
+		const float pOcc = obstacleEvidence(c, res);
 		if (d.kind == TailKind::Deep)
 		{
 			if (k < minRay || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
@@ -377,6 +382,7 @@ void InverseSensorModel::compute(
 		const double dx = x - sensor.x(), dy = y - sensor.y();
 		VoxelClass cls;
 		double dMean = 0;
+		bool deferred = false;  // decided once its samples beyond the band are counted
 		if (dx * dx + dy * dy > maxR2)
 			cls = VoxelClass::OutOfRange;
 		else
@@ -397,11 +403,13 @@ void InverseSensorModel::compute(
 				{
 					m_tailHi[idx] = float(pl.heightAt(x, y) + band / pl.c);
 					m_tailCandidates.push_back({idx, TailKind::Above, 0.f});
+					deferred = true;
 				}
 				else if (cls == VoxelClass::Drop && bottom < -band && top >= -band)
 				{
 					m_tailLo[idx] = float(pl.heightAt(x, y) - band / pl.c);
 					m_tailCandidates.push_back({idx, TailKind::Below, 0.f});
+					deferred = true;
 				}
 			}
 			if (deepTest && cls == VoxelClass::Ground && c.count >= uint32_t(std::max(1, m_params.drop_ray_min_points)))
@@ -436,11 +444,9 @@ void InverseSensorModel::compute(
 					stats.sparse++;
 					break;
 				}
-				// Decided once its samples beyond the band are counted.
-				if (!m_tailCandidates.empty() && m_tailCandidates.back().cell == idx) break;
+				if (deferred) break;
 				(cls == VoxelClass::Drop ? stats.drop : stats.obstacle)++;
-				const double rho = ism::voxelDensity(c.count, c.span(), res);
-				put(idx, float(ism::obstacleProbability(ism::densityConfidence(rho, m_params), m_params)));
+				put(idx, obstacleEvidence(c, res));
 				if (cls == VoxelClass::Drop && m_params.drop_rays &&
 					c.count >= uint32_t(std::max(1, m_params.drop_ray_min_points)))
 					m_dropVoxels.push_back(idx);

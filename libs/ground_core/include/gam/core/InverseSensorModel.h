@@ -335,6 +335,8 @@ class InverseSensorModel
 	std::vector<PaperVoxel> m_paperVoxels, m_paperSorted, m_paperActive;
 	std::vector<uint32_t> m_paperCount;
 	const Plane& choosePlane(const GroundDetection& det, const ElevationCell& c, double x, double y, int block) const;
+	/** P(occ) of an obstacle or drop voxel: eq. (4)-(5) of its density. */
+	float obstacleEvidence(const ElevationCell& c, double resolution) const;
 	void buildSupport(const GridGeometry& g, const GroundDetection& det);
 	/** deep_sample_test: counts each candidate cell's kept samples below its
 	 * threshold, then turns the cells that pass into drops. */
