@@ -641,6 +641,47 @@ TEST(DepthProjector, FlyingPixelsAreTheMixedPixelsOfAnEdge)
 		const Image img = rowImage({1000, 1000, 1000, 1000, 0, 1500, 2000, 2000, 2000, 2000, 2000});
 		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
 	}
+	// A door jamb at 2.0 m with the room behind it beyond the range (0): the
+	// mixed pixel 3200 lies between the jamb and a background that returned
+	// nothing. It is 1200 mm beyond the jamb, more than 50 mm and more than
+	// 5 % of 3200 (160 mm); the jamb side predicts 1 / (2/2000 - 1/2000) =
+	// 2000, 1200 mm from 3200; nothing past the gap returned: flying.
+	{
+		const Image img = rowImage({2000, 2000, 2000, 2000, 2000, 3200, 0, 0, 0, 0, 0});
+		EXPECT_TRUE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 4, 1, tol)) << "the jamb itself";
+	}
+	// The same with a return just past the gap within 50 mm of 3200 (3210: a
+	// surface with a dropout in it): kept.
+	{
+		const Image img = rowImage({2000, 2000, 2000, 2000, 2000, 3200, 0, 3210, 3205, 3200, 3195});
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
+	}
+	// The last floor pixel before the range ends, at a grazing angle: 1/d =
+	// (250 - 3 c) / 1e6 per mm gives 4000, 4049, 4098, 4149, 4202, 4255
+	// (c = 0..5), then nothing. Pixel 5 is 53 mm beyond pixel 4, but the two
+	// pixels before it predict 1 / (2/4202 - 1/4149) = 4256 mm, 1 mm from
+	// 4255: it continues the floor (and 53 < 5 % of 4255 = 213 mm), kept.
+	{
+		std::vector<int> mm;
+		for (int c = 0; c < 6; c++) mm.push_back(int(std::lround(1e6 / (250.0 - 3.0 * c))));
+		ASSERT_EQ(mm[4], 4202);
+		ASSERT_EQ(mm[5], 4255);
+		for (int c = 6; c < 11; c++) mm.push_back(0);
+		const Image img = rowImage(mm);
+		EXPECT_NEAR(1.0 / (2.0 / 4202 - 1.0 / 4149), 4256.0, 0.5);
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
+	}
+	// Far floor with noise next to a dropout: 4150, 4200, then 4330. The near
+	// side predicts 1 / (2/4200 - 1/4150) = 4251 mm, 79 mm from 4330, so it
+	// does not continue within 50 mm; but the jump, 130 mm, is less than 5 %
+	// of 4330 = 216.5 mm: what noise makes between two pixels of one surface
+	// at that range, kept.
+	{
+		const Image img = rowImage({4000, 4050, 4100, 4150, 4200, 4330, 0, 0, 0, 0, 0});
+		EXPECT_NEAR(1.0 / (2.0 / 4200 - 1.0 / 4150), 4251.0, 0.5);
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
+	}
 }
 
 TEST(DepthProjector, FlyingPixelFilterDropsExactlyTheFlyingPixels)
@@ -658,9 +699,13 @@ TEST(DepthProjector, FlyingPixelFilterDropsExactlyTheFlyingPixels)
 		{
 			const bool box = r >= 12 && r < 36 && c >= 20 && c < 44;
 			const bool edge = box && (r == 12 || r == 35 || c == 20 || c == 43);
-			double mm = box ? 1500 : 3000;
-			if (edge && u(rng) < 0.6) mm = 1500 + (0.15 + 0.7 * u(rng)) * 1500;
-			img.at(r, c) = uint16_t(std::lround(mm + noise(rng)));
+			// Right of the box, in its upper half, the background is beyond
+			// the range (no return, 0) and the outline mixes with 6 m.
+			const bool nothing = !box && c >= 44 && r < 24;
+			const double behind = nothing ? 6000 : 3000;
+			double mm = box ? 1500 : behind;
+			if (edge && u(rng) < 0.6) mm = 1500 + (0.15 + 0.7 * u(rng)) * (behind - 1500);
+			img.at(r, c) = nothing ? 0 : uint16_t(std::lround(mm + noise(rng)));
 		}
 	img.at(5, 5) = 0;  // a dropout
 	const ElevationGrid grid(makeGeometry(-5, -5, 0.05, 200, 200));
@@ -675,7 +720,7 @@ TEST(DepthProjector, FlyingPixelFilterDropsExactlyTheFlyingPixels)
 	size_t flying = 0;
 	for (int r = 0; r < H; r++)
 		for (int c = 0; c < W; c++) flying += DepthProjector::isFlyingPixel(img.view(), r, c, 1, 50.0f);
-	EXPECT_EQ(nAll, size_t(W * H - 1));
+	EXPECT_EQ(nAll, size_t(W * H - 1 - (W - 44) * 24));
 	EXPECT_GT(flying, 20u) << "the outline's mixed pixels";
 	EXPECT_EQ(nKept, nAll - flying);
 }

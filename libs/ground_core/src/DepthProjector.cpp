@@ -105,6 +105,10 @@ inline bool between(float a, float d, float b, float tol)
 	return a > 0 && b > 0 && (d - a) * (b - d) > 0 && std::abs(d - a) > tol && std::abs(d - b) > tol;
 }
 
+// Relative depth jump from the near side that a pixel next to a no-return
+// must show to count as flying (see flyingAlong).
+constexpr float kAgainstNothingJump = 0.05f;
+
 // Along one line of the image (a row or a column), the values v[0..6] at
 // offsets -3 ... +3 steps (0 outside the image): see
 // DepthProjector::isFlyingPixel. Mixed pixels come alone or in pairs (both
@@ -113,6 +117,20 @@ inline bool between(float a, float d, float b, float tol)
 bool flyingAlong(const float* v, float tol)
 {
 	const float d = v[3];
+	// Against no return: the background behind an edge beyond the range (or
+	// absorbing) returns nothing, but the mixed pixel still lies between the
+	// edge and that background. One side has no return, the other is nearer
+	// by more than tol and by more than kAgainstNothingJump of d, and d
+	// continues neither the near side nor a return just past the gap. (With
+	// only one side to compare with, the jump must also exceed what noise
+	// makes between two pixels of one surface: at most 4.2 % at p99.99 on
+	// simulated Kinect One frames, up to 78 deg incidence at 4.5 m; with tol
+	// alone, far floor next to a dropout was dropped, 700 pixels a frame.)
+	auto againstNothing = [&](float nearFar, float nearNext, float gap, float beyond) {
+		return gap == 0 && nearNext > 0 && d - nearNext > std::max(tol, kAgainstNothingJump * d) &&
+			   !continues(nearFar, nearNext, d, tol) && !(beyond > 0 && std::abs(beyond - d) <= tol);
+	};
+	if (againstNothing(v[1], v[2], v[4], v[5]) || againstNothing(v[5], v[4], v[2], v[1])) return true;
 	if (between(v[2], d, v[4], tol) && !continues(v[1], v[2], d, tol) && !continues(v[5], v[4], d, tol)) return true;
 	// paired with the next pixel
 	if (std::abs(v[4] - d) <= tol && between(v[2], d, v[5], tol) && between(v[2], v[4], v[5], tol) &&

@@ -82,8 +82,9 @@ inline void projectRow(
 // d2 below; see markFlyingRow in DepthProjector.cpp): keep[c] = 1 for every
 // pixel that cannot be flying, 0 for the candidates (and the two pixels at
 // each end). A line (p2, p1, x, n1, n2) clears x when one side continues to
-// it in depth (|2 p1 - p2 - x| <= h), when x jumps by more than t to neither
-// neighbour (then it is between none) or when a neighbour has no return.
+// it in depth (|2 p1 - p2 - x| <= h, both of its pixels with a return), when
+// x jumps by more than t to neither neighbour (then it is between none) or
+// when a neighbour has no return and the other is not nearer by more than t.
 // All in 16-bit arithmetic (16 pixels per AVX2 instruction): |e| <= h is
 // tested as (e + h) mod 2^16 <= 2 h, which can wrongly clear a pixel only
 // when |2 p1 - p2 - x| >= 2^16 - h, i.e. for depths over 2^15 units (33 m
@@ -96,7 +97,12 @@ inline void flyingCandidates(
 	auto calm = [&](uint16_t p2, uint16_t p1, uint16_t x, uint16_t n1, uint16_t n2) -> uint16_t {
 		const uint16_t el = uint16_t(uint16_t(2 * p1 - p2 - x) + H), er = uint16_t(uint16_t(2 * n1 - n2 - x) + H);
 		const uint16_t dl = uint16_t(x > p1 ? x - p1 : p1 - x), dr = uint16_t(x > n1 ? x - n1 : n1 - x);
-		return uint16_t((el <= H2) | (er <= H2) | ((dl <= T) & (dr <= T)) | (p1 == 0) | (n1 == 0));
+		// A side continues x only where both its pixels returned.
+		const uint16_t contL = (el <= H2) & (p1 != 0) & (p2 != 0), contR = (er <= H2) & (n1 != 0) & (n2 != 0);
+		// Next to a pixel without a return, x can be flying only when the
+		// other neighbour is nearer by more than t.
+		const uint16_t nearL = (p1 != 0) & (x > p1) & (dl > T), nearR = (n1 != 0) & (x > n1) & (dr > T);
+		return uint16_t(contL | contR | ((dl <= T) & (dr <= T)) | ((p1 == 0) & !nearR) | ((n1 == 0) & !nearL));
 	};
 	keep[0] = keep[1] = keep[cols - 2] = keep[cols - 1] = 0;
 	for (int c = 2; c < cols - 2; c++)
