@@ -108,3 +108,41 @@ TEST(SimGroundTruth, CellEdgesAreConservative)
 		for (int dx = -1; dx <= 0; dx++) n += gt.geomLabel[gt.idx(ix + dx, iy + dy)] == Label::Obstacle;
 	EXPECT_EQ(n, 4);
 }
+
+TEST(SimGroundTruth, StepsInsideACellAreObstacles)
+{
+	// An 8 deg ramp with solid sides, 1.2 m long and 0.7 m wide, foot at x =
+	// 0.98, its sides at y = 0.02 +- 0.35 = 0.37 and -0.33 (inside the cells
+	// [0.35, 0.40) and [-0.35, -0.30)), then a 0.6 m plateau that ends in a
+	// vertical face at x = 0.98 + 1.2 + 0.6 = 2.78 (inside [2.75, 2.80)).
+	// Ramp height at u metres from the foot: u tan 8 deg = 0.1405 u, above the
+	// 2 cm obstacle_min_height from u = 0.02 / 0.1405 = 0.142 m on; the
+	// plateau is 1.2 tan 8 deg = 0.169 m high.
+	std::stringstream ss(
+		"path waypoints=0,0,0\n"
+		"ramp id=1 name=r x=0.98 y=0.02 yaw=0 length=1.2 width=0.7 angle=8 sides=solid plateau=0.6\n"
+		"grid resolution=0.05 min_x=0 max_x=4 min_y=-1 max_y=1 subsamples=3\n");
+	SceneFile sf = parseScene(ss, "steps.scene");
+	GroundTruthGrid gt;
+	gt.build(sf.scene, sf.grid);
+	auto at = [&](double x, double y) {
+		int ix, iy;
+		EXPECT_TRUE(gt.cellOf(x, y, ix, iy));
+		return std::make_pair(gt.geomLabel[gt.idx(ix, iy)], gt.objectId[gt.idx(ix, iy)]);
+	};
+	// side cells at u = 0.52 (0.073 m high) and on the plateau (0.169 m): the
+	// ramp's side face, an obstacle of the ramp
+	EXPECT_EQ(at(1.525, 0.375), std::make_pair(Label::Obstacle, 1));
+	EXPECT_EQ(at(1.525, -0.325), std::make_pair(Label::Obstacle, 1));
+	EXPECT_EQ(at(2.425, 0.375), std::make_pair(Label::Obstacle, 1));
+	// the plateau's end face
+	EXPECT_EQ(at(2.775, 0.025), std::make_pair(Label::Obstacle, 1));
+	// at the foot the side is at most 0.07 x 0.1405 = 0.010 m high: free
+	EXPECT_EQ(at(1.025, 0.375).first, Label::Free);
+	// on the slope a cell rises 0.05 x 0.1405 = 0.007 m across: free, the ramp's
+	EXPECT_EQ(at(1.525, 0.025), std::make_pair(Label::Free, 1));
+	EXPECT_EQ(at(2.425, 0.025), std::make_pair(Label::Free, 1));
+	// the floor one cell beyond each face: free
+	EXPECT_EQ(at(1.525, 0.425), std::make_pair(Label::Free, 0));
+	EXPECT_EQ(at(2.825, 0.025), std::make_pair(Label::Free, 0));
+}

@@ -3,17 +3,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace gam::sim
 {
 int GridSpec::nx() const { return std::max(1, int(std::lround((max_x - min_x) / resolution))); }
 int GridSpec::ny() const { return std::max(1, int(std::lround((max_y - min_y) / resolution))); }
 
-Label GroundTruthGrid::probe(const Scene& scene, const GridSpec& s, double x, double y, int& obj)
+Label GroundTruthGrid::probe(const Scene& scene, const GridSpec& s, double x, double y, int& obj, double* support)
 {
 	obj = 0;
 	if (!scene.has_floor) return Label::Drop;
 	double g = 0;
+
 	int negObj = 0, supportObj = 0;
 	for (const auto& h : scene.holes)
 		if (h.containsXY(x, y) && -h.depth < g)
@@ -48,6 +50,7 @@ Label GroundTruthGrid::probe(const Scene& scene, const GridSpec& s, double x, do
 			}
 		}
 	}
+	if (support) *support = g;
 	double bestTop = -1e9;
 	int obstObj = 0;
 	for (const auto& e : ext)
@@ -128,6 +131,32 @@ void GroundTruthGrid::labelCell(const Scene& scene, int ix, int iy)
 				first = false;
 			}
 		}
+	if (best == Label::Free)
+	{
+		// A step inside the cell: the support level of its free probes, taken
+		// on a lattice that includes the cell's edges (a face between two
+		// inner probes of neighbouring cells would fall through the inner
+		// lattice), varies by more than obstacle_min_height. The side face
+		// of a raised ramp or the end of its plateau: nobody crosses it.
+		double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+		int hiObj = 0;
+		for (int a = 0; a <= k; a++)
+			for (int b = 0; b <= k; b++)
+			{
+				const double x = s.min_x + (ix + double(a) / k) * s.resolution;
+				const double y = s.min_y + (iy + double(b) / k) * s.resolution;
+				int obj;
+				double g = 0;
+				if (probe(scene, s, x, y, obj, &g) != Label::Free) continue;
+				lo = std::min(lo, g);
+				if (g > hi) hi = g, hiObj = obj;
+			}
+		if (hi - lo > s.obstacle_min_height)
+		{
+			best = Label::Obstacle;
+			bestObj = hiObj;
+		}
+	}
 	geomLabel[idx(ix, iy)] = best;
 	objectId[idx(ix, iy)] = bestObj;
 }

@@ -11,6 +11,11 @@
 //    above robot_height (e.g. a high shelf board) do not count.
 //  * drop: no obstacle and g < -drop_min_depth (holes, outlets, stairwells,
 //    bottomless pits).
+//  * obstacle too: a step inside a cell that is otherwise free, i.e. the
+//    support level g of its free probes varies by more than
+//    obstacle_min_height (probed on (subsamples + 1)^2 points that include
+//    the cell's edges): the side face of a raised ramp, the end of a plateau
+//    without a back slope. Object: the higher support (the ramp).
 //  * free: otherwise (floor, ramps).
 //  * unobserved: the cell received no point of any frame's geometric visible
 //    footprint (see DepthFrame::footprint); this replaces the label (the
@@ -78,8 +83,9 @@ class GroundTruthGrid
 
 	/** Labels one cell from its subsamples x subsamples probes (the worst wins). */
 	void labelCell(const Scene& scene, int ix, int iy);
-	/** Geometric probe at one point: label and object id. */
-	static Label probe(const Scene& scene, const GridSpec& s, double x, double y, int& obj);
+	/** Geometric probe at one point: label and object id (and, if asked, the
+	 * support level g there). */
+	static Label probe(const Scene& scene, const GridSpec& s, double x, double y, int& obj, double* support = nullptr);
 };
 
 }  // namespace gam::sim
