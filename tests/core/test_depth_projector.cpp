@@ -591,6 +591,15 @@ Image rowImage(const std::vector<int>& mm)
 		for (size_t c = 0; c < mm.size(); c++) img.at(r, int(c)) = uint16_t(mm[c]);
 	return img;
 }
+
+// rowImage() with rows 1 and 3 without a return: pixel (2, c) then has no
+// neighbour above or below it (nor diagonally) to lean on.
+Image loneRowImage(const std::vector<int>& mm)
+{
+	Image img = rowImage(mm);
+	for (size_t c = 0; c < mm.size(); c++) img.at(1, int(c)) = img.at(3, int(c)) = 0;
+	return img;
+}
 }  // namespace
 
 TEST(DepthProjector, FlyingPixelsAreTheMixedPixelsOfAnEdge)
@@ -645,16 +654,40 @@ TEST(DepthProjector, FlyingPixelsAreTheMixedPixelsOfAnEdge)
 	// mixed pixel 3200 lies between the jamb and a background that returned
 	// nothing. It is 1200 mm beyond the jamb, more than 50 mm and more than
 	// 5 % of 3200 (160 mm); the jamb side predicts 1 / (2/2000 - 1/2000) =
-	// 2000, 1200 mm from 3200; nothing past the gap returned: flying.
+	// 2000, 1200 mm from 3200; nothing past the gap returned. Above and below
+	// it, other mixed pixels at random depths (3900, 2600 | 2700, 3800): not
+	// between their neighbours in the column (2600 < 3200 > 2700), and none
+	// of its 8 neighbours is within 50 mm: it stands alone, flying.
 	{
-		const Image img = rowImage({2000, 2000, 2000, 2000, 2000, 3200, 0, 0, 0, 0, 0});
+		Image img = rowImage({2000, 2000, 2000, 2000, 2000, 3200, 0, 0, 0, 0, 0});
+		const int column[5] = {3900, 2600, 3200, 2700, 3800};
+		for (int r = 0; r < 5; r++) img.at(r, 5) = uint16_t(column[r]);
 		EXPECT_TRUE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
 		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 4, 1, tol)) << "the jamb itself";
+		// The floor just past a step's edge looks the same along its column
+		// (here the row): 4000 on the upper floor, then 4270 (a 5 cm step seen
+		// from 0.8 m: 5/80 = 6.25 % farther, more than 5 % of 4270 = 213.5 mm),
+		// then a dropout. But the lower floor goes on across the image: its
+		// neighbours in the other line, 4265 and 4280, are within 50 mm. Kept.
+		Image step = rowImage({4000, 4000, 4000, 4000, 4000, 4270, 0, 0, 0, 0, 0});
+		const int floorColumn[5] = {4255, 4265, 4270, 4280, 4290};
+		for (int r = 0; r < 5; r++) step.at(r, 5) = uint16_t(floorColumn[r]);
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(step.view(), 2, 5, 1, tol));
+		// Without them (a dropout above and below, 4300 and 4310 diagonally:
+		// 30 and 40 mm away) it still has support: kept.
+		step.at(1, 5) = step.at(3, 5) = 0;
+		step.at(1, 6) = 4300;
+		step.at(3, 6) = 4310;
+		EXPECT_FALSE(DepthProjector::isFlyingPixel(step.view(), 2, 5, 1, tol));
+		// With no neighbour within 50 mm at all: flying.
+		step.at(1, 6) = step.at(3, 6) = 0;
+		EXPECT_TRUE(DepthProjector::isFlyingPixel(step.view(), 2, 5, 1, tol));
 	}
-	// The same with a return just past the gap within 50 mm of 3200 (3210: a
-	// surface with a dropout in it): kept.
+	// In the rest, rows 1 and 3 returned nothing: the pixel stands alone.
+	// A return just past the gap within 50 mm of 3200 (3210: a surface with
+	// a dropout in it): kept.
 	{
-		const Image img = rowImage({2000, 2000, 2000, 2000, 2000, 3200, 0, 3210, 3205, 3200, 3195});
+		const Image img = loneRowImage({2000, 2000, 2000, 2000, 2000, 3200, 0, 3210, 3205, 3200, 3195});
 		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
 	}
 	// The last floor pixel before the range ends, at a grazing angle: 1/d =
@@ -668,7 +701,7 @@ TEST(DepthProjector, FlyingPixelsAreTheMixedPixelsOfAnEdge)
 		ASSERT_EQ(mm[4], 4202);
 		ASSERT_EQ(mm[5], 4255);
 		for (int c = 6; c < 11; c++) mm.push_back(0);
-		const Image img = rowImage(mm);
+		const Image img = loneRowImage(mm);
 		EXPECT_NEAR(1.0 / (2.0 / 4202 - 1.0 / 4149), 4256.0, 0.5);
 		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
 	}
@@ -678,7 +711,7 @@ TEST(DepthProjector, FlyingPixelsAreTheMixedPixelsOfAnEdge)
 	// of 4330 = 216.5 mm: what noise makes between two pixels of one surface
 	// at that range, kept.
 	{
-		const Image img = rowImage({4000, 4050, 4100, 4150, 4200, 4330, 0, 0, 0, 0, 0});
+		const Image img = loneRowImage({4000, 4050, 4100, 4150, 4200, 4330, 0, 0, 0, 0, 0});
 		EXPECT_NEAR(1.0 / (2.0 / 4200 - 1.0 / 4150), 4251.0, 0.5);
 		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
 	}

@@ -106,7 +106,7 @@ inline bool between(float a, float d, float b, float tol)
 }
 
 // Relative depth jump from the near side that a pixel next to a no-return
-// must show to count as flying (see flyingAlong).
+// must show to count as flying (see againstNothingAlong).
 constexpr float kAgainstNothingJump = 0.05f;
 
 // Along one line of the image (a row or a column), the values v[0..6] at
@@ -117,20 +117,6 @@ constexpr float kAgainstNothingJump = 0.05f;
 bool flyingAlong(const float* v, float tol)
 {
 	const float d = v[3];
-	// Against no return: the background behind an edge beyond the range (or
-	// absorbing) returns nothing, but the mixed pixel still lies between the
-	// edge and that background. One side has no return, the other is nearer
-	// by more than tol and by more than kAgainstNothingJump of d, and d
-	// continues neither the near side nor a return just past the gap. (With
-	// only one side to compare with, the jump must also exceed what noise
-	// makes between two pixels of one surface: at most 4.2 % at p99.99 on
-	// simulated Kinect One frames, up to 78 deg incidence at 4.5 m; with tol
-	// alone, far floor next to a dropout was dropped, 700 pixels a frame.)
-	auto againstNothing = [&](float nearFar, float nearNext, float gap, float beyond) {
-		return gap == 0 && nearNext > 0 && d - nearNext > std::max(tol, kAgainstNothingJump * d) &&
-			   !continues(nearFar, nearNext, d, tol) && !(beyond > 0 && std::abs(beyond - d) <= tol);
-	};
-	if (againstNothing(v[1], v[2], v[4], v[5]) || againstNothing(v[5], v[4], v[2], v[1])) return true;
 	if (between(v[2], d, v[4], tol) && !continues(v[1], v[2], d, tol) && !continues(v[5], v[4], d, tol)) return true;
 	// paired with the next pixel
 	if (std::abs(v[4] - d) <= tol && between(v[2], d, v[5], tol) && between(v[2], v[4], v[5], tol) &&
@@ -139,6 +125,33 @@ bool flyingAlong(const float* v, float tol)
 	// paired with the previous pixel
 	return std::abs(v[2] - d) <= tol && between(v[1], d, v[4], tol) && between(v[1], v[2], v[4], tol) &&
 		   !continues(v[0], v[1], v[2], tol) && !continues(v[5], v[4], d, tol);
+}
+
+// Against no return, along one line: the background behind an edge beyond
+// the range (or absorbing) returns nothing, but the mixed pixel still lies
+// between the edge and that background. One side has no return, the other
+// is nearer by more than tol and by more than kAgainstNothingJump of d, and d
+// continues neither the near side nor a return just past the gap. (With only
+// one side to compare with, the jump must also exceed what noise makes
+// between two pixels of one surface: at most 4.2 % at p99.99 on simulated
+// Kinect One frames, up to 78 deg incidence at 4.5 m; with tol alone, far
+// floor next to a dropout was dropped, 700 pixels a frame.)
+bool againstNothingAlong(const float* v, float tol)
+{
+	const float d = v[3];
+	auto one = [&](float nearFar, float nearNext, float gap, float beyond) {
+		return gap == 0 && nearNext > 0 && d - nearNext > std::max(tol, kAgainstNothingJump * d) &&
+			   !continues(nearFar, nearNext, d, tol) && !(beyond > 0 && std::abs(beyond - d) <= tol);
+	};
+	return one(v[1], v[2], v[4], v[5]) || one(v[5], v[4], v[2], v[1]);
+}
+
+// A neighbour along the line within tol of the pixel: it lies on a surface
+// there (the far floor just past a step's edge continues along its row while
+// the column beyond it drops out; a mixed pixel has no such neighbour).
+inline bool supportedAlong(const float* v, float tol)
+{
+	return (v[2] > 0 && std::abs(v[2] - v[3]) <= tol) || (v[4] > 0 && std::abs(v[4] - v[3]) <= tol);
 }
 
 // Both lines through pixel (r, c), neighbours `step` apart.
@@ -169,7 +182,25 @@ bool flyingAt(const RangeImageView& img, int r, int c, int step, float tol)
 			w[o + 3] = v(r + o * step, c);
 		}
 	}
-	return flyingAlong(h, tol) || flyingAlong(w, tol);
+	if (flyingAlong(h, tol) || flyingAlong(w, tol)) return true;
+	if (!againstNothingAlong(h, tol) && !againstNothingAlong(w, tol)) return false;
+	// Against no return, a pixel must also stand alone: no neighbour of the
+	// 8 within tol of it. The floor just past a step's edge jumps as far (by
+	// the step's height over the camera's, 6 % for 5 cm from 0.8 m) and may
+	// have a dropout beyond it, but it continues along its row or diagonally;
+	// a mixed pixel's neighbours are the edge, the void and other mixed pixels
+	// at random depths.
+	const float d = h[3];
+	if (supportedAlong(h, tol) || supportedAlong(w, tol)) return false;
+	for (int dr = -1; dr <= 1; dr += 2)
+		for (int dc = -1; dc <= 1; dc += 2)
+		{
+			const int rr = r + dr * step, cc = c + dc * step;
+			if (rr < 0 || cc < 0 || rr >= img.rows || cc >= img.cols) continue;
+			const float n = float(img.at(rr, cc));
+			if (n > 0 && std::abs(n - d) <= tol) return false;
+		}
+	return true;
 }
 
 // Marks the flying pixels of row r (every dec-th column) in keep[k] = 0.
