@@ -123,8 +123,13 @@ class DepthProjector
 	 * too. A mixed pixel at a depth edge is flying; a floor seen at a grazing
 	 * angle (steep but affine in inverse depth), the wall of a hole
 	 * (continuous with its neighbour on the wall, or farther than both) and a
-	 * thin object (nearer than both neighbours) are not. Depths and `tol` in
-	 * the image's units; 0 = no return (a side with a 0 predicts nothing). */
+	 * thin object (nearer than both neighbours) are not. Next to a no-return
+	 * (a background beyond the range) a pixel is flying when its other
+	 * neighbour is nearer by more than `tol` and 5 % of its depth, it
+	 * continues neither that side nor a return just past the gap, and none of
+	 * its 8 neighbours is within `tol` (the floor past a step's edge goes on
+	 * along its row). Depths and `tol` in the image's units; 0 = no return
+	 * (a side with a 0 predicts nothing). */
 	static bool isFlyingPixel(const RangeImageView& img, int row, int col, int step, float tol);
 
 	/** Whether the AVX2 row loop can run here (CPU and build). */
