@@ -79,6 +79,32 @@ bool RrtGroundDetector::fitLocalPlane(const ElevationGrid& grid, int cx, int cy,
 	return true;
 }
 
+bool RrtGroundDetector::planarEnough(const Plane& local, double rms) const
+{
+	return !(rms > m_params.max_fit_rms || local.horizontalNormal() > m_params.normal_threshold);
+}
+
+bool RrtGroundDetector::childAt(
+	const ElevationGrid& grid, const GroundNode& parent, int parentIdx, int cx, int cy, GroundNode& child) const
+{
+	const GridGeometry& g = grid.geometry();
+	float z;
+	if (!cellHeight(grid, cx, cy, z)) return false;
+	const double px = g.cx(cx), py = g.cy(cy);
+	// Elevation test against the parent's local plane (lets the tree climb
+	// gentle ramps, stops it at steps, boxes and drops).
+	if (std::abs(double(z) - parent.local.heightAt(px, py)) > m_params.elevation_threshold) return false;
+	Plane pl;
+	double rms;
+	if (!fitLocalPlane(grid, cx, cy, pl, rms) || !planarEnough(pl, rms)) return false;
+	child.x = float(px);
+	child.y = float(py);
+	child.z = float(pl.heightAt(px, py));
+	child.local = pl;
+	child.parent = parentIdx;
+	return true;
+}
+
 bool RrtGroundDetector::findSeed(const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed)
 {
 	const GridGeometry& g = grid.geometry();
@@ -110,8 +136,7 @@ bool RrtGroundDetector::findSeed(const ElevationGrid& grid, const GroundSeedHint
 		if (std::abs(z - hint.floor_z) > m_params.seed_height_tolerance) continue;
 		Plane pl;
 		double rms;
-		if (!fitLocalPlane(grid, cx, cy, pl, rms)) continue;
-		if (rms > m_params.max_fit_rms || pl.horizontalNormal() > m_params.normal_threshold) continue;
+		if (!fitLocalPlane(grid, cx, cy, pl, rms) || !planarEnough(pl, rms)) continue;
 		seed.x = float(g.cx(cx));
 		seed.y = float(g.cy(cy));
 		seed.z = float(pl.heightAt(seed.x, seed.y));
@@ -240,20 +265,8 @@ void RrtGroundDetector::fillPatches(const ElevationGrid& grid, const Plane& grou
 			if (out.nodes.size() >= cap) break;
 			const int cx = pcx + d[0] * sx, cy = pcy + d[1] * sy;
 			if (!g.inside(cx, cy) || !windowFree(cx, cy)) continue;
-			float z;
-			if (!cellHeight(grid, cx, cy, z)) continue;
-			const double px = g.cx(cx), py = g.cy(cy);
-			if (std::abs(double(z) - parent.local.heightAt(px, py)) > m_params.elevation_threshold) continue;
-			Plane pl;
-			double rms;
-			if (!fitLocalPlane(grid, cx, cy, pl, rms)) continue;
-			if (rms > m_params.max_fit_rms || pl.horizontalNormal() > m_params.normal_threshold) continue;
 			GroundNode node;
-			node.x = float(px);
-			node.y = float(py);
-			node.z = float(pl.heightAt(px, py));
-			node.local = pl;
-			node.parent = int(pi);
+			if (!childAt(grid, parent, int(pi), cx, cy, node)) continue;
 			addTreeNode(g, node, cx, cy, out);
 			if (offGround(node)) m_fillQueue.push_back(uint32_t(out.nodes.size() - 1));
 		}
@@ -441,28 +454,13 @@ void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& se
 		const int cx = g.ix(nx_), cy = g.iy(ny_);
 		if (!g.inside(cx, cy)) continue;
 		if (m_hasNode[g.index(cx, cy)]) continue;
-		float z;
-		if (!cellHeight(grid, cx, cy, z)) continue;
-		const double px = g.cx(cx), py = g.cy(cy);
-		// Elevation test against the parent's local plane (lets the tree climb
-		// gentle ramps, stops it at steps, boxes and drops).
-		if (std::abs(double(z) - near.local.heightAt(px, py)) > m_params.elevation_threshold) continue;
-		Plane pl;
-		double rms;
-		if (!fitLocalPlane(grid, cx, cy, pl, rms)) continue;
-		if (rms > m_params.max_fit_rms || pl.horizontalNormal() > m_params.normal_threshold) continue;
-
 		GroundNode node;
-		node.x = float(px);
-		node.y = float(py);
-		node.z = float(pl.heightAt(px, py));
-		node.local = pl;
-		node.parent = int(nearIdx);
+		if (!childAt(grid, near, int(nearIdx), cx, cy, node)) continue;
 		addTreeNode(g, node, cx, cy, out);
-		bx0 = std::min(bx0, px);
-		bx1 = std::max(bx1, px);
-		by0 = std::min(by0, py);
-		by1 = std::max(by1, py);
+		bx0 = std::min(bx0, g.cx(cx));
+		bx1 = std::max(bx1, g.cx(cx));
+		by0 = std::min(by0, g.cy(cy));
+		by1 = std::max(by1, g.cy(cy));
 	}
 }
 

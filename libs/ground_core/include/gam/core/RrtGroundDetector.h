@@ -240,6 +240,13 @@ class RrtGroundDetector
 
    private:
 	bool cellHeight(const ElevationGrid& grid, int cx, int cy, float& z) const;
+	/** A local fit the tree accepts: RMS within max_fit_rms, normal within N_th of vertical. */
+	bool planarEnough(const Plane& local, double rms) const;
+	/** The child `parent` (index parentIdx) would get at cell (cx, cy): the
+	 * cell's height within E_th of the parent's local plane there, its own
+	 * local fit planarEnough(). False if a test fails (`child` undefined). */
+	bool childAt(
+		const ElevationGrid& grid, const GroundNode& parent, int parentIdx, int cx, int cy, GroundNode& child) const;
 	bool findSeed(const ElevationGrid& grid, const GroundSeedHint& hint, GroundNode& seed);
 	/** Empties the tree (and its node index) and plants `seed`: both variants. */
 	void startTree(const GridGeometry& g, const GroundNode& seed, GroundDetection& out);
