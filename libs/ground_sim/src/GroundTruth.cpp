@@ -15,7 +15,6 @@ Label GroundTruthGrid::probe(const Scene& scene, const GridSpec& s, double x, do
 	obj = 0;
 	if (!scene.has_floor) return Label::Drop;
 	double g = 0;
-
 	int negObj = 0, supportObj = 0;
 	for (const auto& h : scene.holes)
 		if (h.containsXY(x, y) && -h.depth < g)
