@@ -304,6 +304,38 @@ TEST(Eval, OutsideTheMapIsUnknown)
 	for (const auto& c : reportCategories()) EXPECT_EQ(cat(far.main, c).detected, 0);
 }
 
+TEST(Eval, RampsAreScoredPerObject)
+{
+	// The ramp 'r' (object 5) is the 2 x 2 cells of rows 5-6 of kScene
+	// (iy 4 and 3), columns 11-12: one occupied (0), one unknown (128), two free. Of the 4 cells: 25 %
+	// occupied, 50 % free, 25 % unknown; free of the 3 the map knows: 2/3.
+	TempDir d;
+	const GroundTruth gt = loadGroundTruth(writeGt(d));
+	auto px = perfectPixels();
+	at(px, 11, 4) = 0;
+	at(px, 12, 3) = 128;
+	const MapScore s = evaluate(gt, loadRosMap(writeMap(d, "m", px, kRes, 0, 0)));
+	ASSERT_EQ(s.main.ramps.size(), 1u);
+	const RampScore& r = s.main.ramps.front();
+	EXPECT_EQ(r.id, 5);
+	EXPECT_EQ(r.name, "ramp");
+	EXPECT_EQ(r.cells.n, 4);
+	EXPECT_EQ(r.cells.occupied, 1);
+	EXPECT_EQ(r.cells.free, 2);
+	EXPECT_EQ(r.cells.unknown, 1);
+	EXPECT_NEAR(r.freeOfKnownPct(), 100.0 * 2.0 / 3.0, 1e-9);
+	EXPECT_EQ(s.main.ramp.occupied, 1) << "the pooled ramp counts agree";
+	const std::vector<MapScore> v{s};
+	EXPECT_NE(toCsv(v).find("m,main,ramp_object,5,ramp,4,1,2,1,0\n"), std::string::npos);
+	EXPECT_NE(
+		toJson(gt, v, {}).find("\"name\": \"ramp\", \"counts\": {\"cells\": 4, \"occupied\": 1"), std::string::npos);
+	EXPECT_NE(toJson(gt, v, {}).find("\"free_of_known_pct\": 66.667"), std::string::npos);
+	EXPECT_NE(
+		formatTable(gt, v, {}).find(
+			"ramp ramp: 4 cells, occupied 25.0 %, free 50.0 %, unknown 25.0 %; free of known 66.7 %"),
+		std::string::npos);
+}
+
 TEST(Eval, TrinaryAndNegate)
 {
 	TempDir d;

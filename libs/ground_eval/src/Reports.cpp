@@ -76,6 +76,16 @@ std::string readingJson(const Reading& rd, const std::string& ind)
 	o << ind << "  \"floor_false_obstacle_pct\": " << fmt("%.3f", rd.floor.pct(rd.floor.occupied)) << ",\n";
 	o << ind << "  \"floor_free_pct\": " << fmt("%.3f", rd.floor.pct(rd.floor.free)) << ",\n";
 	o << ind << "  \"ramp\": " << countsJson(rd.ramp) << ",\n";
+	o << ind << "  \"ramps\": [";
+	first = true;
+	for (const auto& r : rd.ramps)
+	{
+		o << (first ? "\n" : ",\n") << ind << "    {\"id\": " << r.id << ", \"name\": " << jsonStr(r.name)
+		  << ", \"counts\": " << countsJson(r.cells) << ", \"free_of_known_pct\": " << fmt("%.3f", r.freeOfKnownPct())
+		  << "}";
+		first = false;
+	}
+	o << (rd.ramps.empty() ? "" : "\n" + ind + "  ") << "],\n";
 	o << ind << "  \"obstacle_cells\": " << countsJson(rd.obstacle) << ",\n";
 	o << ind << "  \"objects\": [";
 	first = true;
@@ -119,6 +129,16 @@ std::string formatTable(const GroundTruth& gt, const std::vector<MapScore>& scor
 				catCell(*rd, "overhang").c_str(), catCell(*rd, "large").c_str(), rd->floor.pct(rd->floor.occupied),
 				rd->floor.pct(rd->floor.free), rd->floor.pct(rd->floor.unknown),
 				rd->obstacle.pct(rd->obstacle.occupied));
+			o << b;
+		}
+	for (const auto& s : scores)
+		for (const auto& r : s.main.ramps)
+		{
+			std::snprintf(
+				b, sizeof(b),
+				"%-14s ramp %s: %ld cells, occupied %.1f %%, free %.1f %%, unknown %.1f %%; free of known %.1f %%\n",
+				s.name.c_str(), r.name.c_str(), r.cells.n, r.cells.pct(r.cells.occupied), r.cells.pct(r.cells.free),
+				r.cells.pct(r.cells.unknown), r.freeOfKnownPct());
 			o << b;
 		}
 	if (!scores.empty())
@@ -174,6 +194,9 @@ std::string toCsv(const std::vector<MapScore>& scores)
 			cc("floor", rd->floor);
 			cc("ramp", rd->ramp);
 			cc("obstacle", rd->obstacle);
+			for (const auto& r : rd->ramps)
+				o << pre << "ramp_object," << r.id << ",ramp," << r.cells.n << "," << r.cells.occupied << ","
+				  << r.cells.free << "," << r.cells.unknown << ",0\n";
 		}
 	return o.str();
 }

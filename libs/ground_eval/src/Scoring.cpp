@@ -101,6 +101,7 @@ Reading score(
 {
 	Reading rd;
 	std::map<int, ObjectScore> objs;
+	std::map<int, CellCounts> ramps;
 	for (size_t i = 0; i < st.size(); i++)
 	{
 		const Label l = gt.label[i];
@@ -118,9 +119,14 @@ Reading score(
 		{
 			count(rd.floor, st[i]);
 			const GtObject* o = gt.objectId[i] ? gt.object(gt.objectId[i]) : nullptr;
-			if (o && o->category == "ramp") count(rd.ramp, st[i]);
+			if (o && o->category == "ramp")
+			{
+				count(rd.ramp, st[i]);
+				count(ramps[gt.objectId[i]], st[i]);
+			}
 		}
 	}
+	for (const auto& [id, c] : ramps) rd.ramps.push_back({id, gt.object(id)->name, c});
 	for (auto& [id, o] : objs)
 	{
 		const GtObject* g = gt.object(id);

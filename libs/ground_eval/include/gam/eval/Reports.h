@@ -18,7 +18,7 @@ std::string formatTable(const GroundTruth& gt, const std::vector<MapScore>& scor
 /** JSON document with every number. */
 std::string toJson(const GroundTruth& gt, const std::vector<MapScore>& scores, const Options& opt);
 /** Flat CSV for aggregation: map,reading,record,id,category,n,occupied,free,unknown,detected
- * (record = object | floor | ramp | obstacle). */
+ * (record = object | floor | ramp | obstacle | ramp_object: one per ramp, id = its object). */
 std::string toCsv(const std::vector<MapScore>& scores);
 
 }  // namespace gam::eval

@@ -82,6 +82,23 @@ struct CellCounts
 	double pct(long v) const { return n ? 100.0 * double(v) / double(n) : 0.0; }
 };
 
+/** The scored floor cells of one ramp object (issue #13: a ramp must stay
+ * free). Unknown = the simulator's noise-free ray reached the cell but the
+ * map has no evidence there: the camera returned nothing (grazing dropouts on
+ * a ramp's far side) or the cell was only ever at the edge of the view. */
+struct RampScore
+{
+	int id = 0;
+	std::string name;
+	CellCounts cells;
+	/** Free share of the cells the map knows (occupied or free) [%]. */
+	double freeOfKnownPct() const
+	{
+		const long known = cells.occupied + cells.free;
+		return known ? 100.0 * double(cells.free) / double(known) : 0.0;
+	}
+};
+
 /** Scores of one map with one reading (thresholds). */
 struct Reading
 {
@@ -89,9 +106,10 @@ struct Reading
 	double occ = 0.5, free = 0.5;
 	std::vector<ObjectScore> objects;
 	std::map<std::string, CategoryScore> categories;
-	CellCounts floor;     ///< scored floor cells
-	CellCounts ramp;      ///< the scored floor cells of category ramp
-	CellCounts obstacle;  ///< observed GT obstacle/drop cells
+	CellCounts floor;              ///< scored floor cells
+	CellCounts ramp;               ///< the scored floor cells of category ramp
+	std::vector<RampScore> ramps;  ///< the same per ramp object, by id
+	CellCounts obstacle;           ///< observed GT obstacle/drop cells
 };
 
 struct MapScore
