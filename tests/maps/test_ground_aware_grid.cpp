@@ -113,7 +113,9 @@ TEST(GroundAwareGrid, RampStaysFreeWithLocalPlanesOnly)
 	auto globalOnly = global.groundOptions();
 	globalOnly.pipeline.ism.local_planes = false;
 	global.setGroundOptions(globalOnly);
-	auto obs = testscene::renderDepth(s, kKinect);
+	// The Kinect One's full 512 x 424 image: at half of it the far ramp cells
+	// hold one or two samples, fewer than min_obstacle_points.
+	auto obs = testscene::renderDepth(s, kKinect, {}, 512, 424);
 	local.insertObservation(*obs);
 	global.insertObservation(*obs);
 	ASSERT_TRUE(local.lastFrame().detection.ok());

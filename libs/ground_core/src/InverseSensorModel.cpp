@@ -284,7 +284,6 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 			m_tailCount[c]++;
 	}
 	const double alpha = ism::normalTail(m_params.noise_sigmas);
-	const uint32_t minPoints = uint32_t(std::max(1, m_params.min_obstacle_points));
 	const uint32_t minRay = uint32_t(std::max(1, m_params.drop_ray_min_points));
 	const double res = frame.geometry().resolution;
 	for (const TailCandidate& d : m_tailCandidates)
@@ -309,12 +308,12 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 		// An obstacle or a drop judged by its extreme sample: it takes as many
 		// samples beyond the band as any other (a lone spike among floor
 		// samples is no obstacle, and casts no ray).
-		if (k < minPoints)
+		const bool drop = d.kind == TailKind::Below;
+		if (k < minPoints(drop ? VoxelClass::Drop : VoxelClass::Obstacle, d.onPatch))
 		{
 			stats.sparse++;
 			continue;
 		}
-		const bool drop = d.kind == TailKind::Below;
 		(drop ? stats.drop : stats.obstacle)++;
 		put(d.cell, pOcc);
 		if (drop && m_params.drop_rays && k >= minRay) m_dropVoxels.push_back(d.cell);
@@ -383,18 +382,20 @@ void InverseSensorModel::compute(
 		VoxelClass cls;
 		double dMean = 0;
 		bool deferred = false;  // decided once its samples beyond the band are counted
+		bool onPatch = false;   // judged against a ramp or landing patch, not the ground plane
 		if (dx * dx + dy * dy > maxR2)
 			cls = VoxelClass::OutOfRange;
 		else
 		{
 			const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
 			const Plane& pl = choosePlane(det, c, x, y, block);
+			onPatch = &pl != &det.planes.front();
 			const double hs = pl.signedDistance(sensor.x(), sensor.y(), sensor.z());
 			const double band = groundBand(sensor, hs, x, y, c.mean());
 			const double tau = floorOffset(sensor, x, y, c.mean());
 			cls = classify(c, x, y, pl, band, dMean, tau);
 			if (haveSamples && pl.c > 0 && (cls == VoxelClass::Obstacle || cls == VoxelClass::Drop) &&
-				c.count >= uint32_t(std::max(1, m_params.min_obstacle_points)))
+				c.count >= minPoints(cls, onPatch))
 			{
 				// Judged by its top (bottom) sample while others lie in the band:
 				// count the samples beyond the band before it counts.
@@ -402,13 +403,13 @@ void InverseSensorModel::compute(
 				if (cls == VoxelClass::Obstacle && top > band && bottom <= band)
 				{
 					m_tailHi[idx] = float(pl.heightAt(x, y) + band / pl.c);
-					m_tailCandidates.push_back({idx, TailKind::Above, 0.f});
+					m_tailCandidates.push_back({idx, TailKind::Above, 0.f, onPatch});
 					deferred = true;
 				}
 				else if (cls == VoxelClass::Drop && bottom < -band && top >= -band)
 				{
 					m_tailLo[idx] = float(pl.heightAt(x, y) - band / pl.c);
-					m_tailCandidates.push_back({idx, TailKind::Below, 0.f});
+					m_tailCandidates.push_back({idx, TailKind::Below, 0.f, onPatch});
 					deferred = true;
 				}
 			}
@@ -424,7 +425,7 @@ void InverseSensorModel::compute(
 				{
 					// signedDistance = c (z - heightAt) for a unit normal.
 					m_tailLo[idx] = float(pl.heightAt(x, y) - T / pl.c);
-					m_tailCandidates.push_back({idx, TailKind::Deep, float(ism::normalTail(T / s))});
+					m_tailCandidates.push_back({idx, TailKind::Deep, float(ism::normalTail(T / s)), false});
 				}
 			}
 		}
@@ -438,7 +439,7 @@ void InverseSensorModel::compute(
 				break;
 			case VoxelClass::Obstacle:
 			case VoxelClass::Drop: {
-				if (c.count < uint32_t(std::max(1, m_params.min_obstacle_points)))
+				if (c.count < minPoints(cls, onPatch))
 				{
 					// A lone return (a depth spike) is no evidence of anything.
 					stats.sparse++;

@@ -81,14 +81,28 @@ struct IsmParams
 	 * cross them (the simulator's ground truth uses the same 2 cm). The band
 	 * of the mean never gets narrower. [m] */
 	double traversable_step = 0.02;
-	/** Obstacle and drop voxels with fewer samples give no evidence. Any real
-	 * surface within a depth camera's range fills a d_r cell with several
-	 * samples (a 5 cm cell of floor 4.5 m away from a 512x424 Kinect One
-	 * 1 m up still gets ~4), a single depth spike or flying pixel only one.
-	 * A voxel judged by its top (bottom) sample while others lie in the band
-	 * needs this many samples beyond the band (given the frame's samples):
-	 * a spike among floor samples is no obstacle. */
-	int min_obstacle_points = 2;
+	/** Obstacle voxels with fewer samples give no evidence. What blocks the
+	 * robot faces the camera: a 4 cm tall face 4.5 m away fills a d_r = 5 cm
+	 * cell with ~16 samples of a 512x424 Kinect One (11 mm between pixels
+	 * there). A surface seen at grazing incidence does not: a cell of floor
+	 * 4.5 m away from 0.8 m up (80 deg) gets ~4 rays, fewer after dropouts,
+	 * and so does the far side of a ramp (84 deg), whose one to three samples
+	 * per cell sit a few cm off the landing's plane or above the floor's. A
+	 * lone depth spike or flying pixel gives one sample, a pair of them two.
+	 * So 3 (it was 2 for both kinds: floor false obstacles in door_opening
+	 * 0.62 -> 0.35 %, see doc/benchmark.md). A drop below a ramp or landing
+	 * patch takes this count too: seen from afar, the far side of the ramp
+	 * is such a drop. A voxel judged by its top (bottom) sample while others
+	 * lie in the band needs this many samples beyond the band (given the
+	 * frame's samples): a spike among floor samples is no obstacle. */
+	int min_obstacle_points = 3;
+	/** Drop voxels below the ground plane (the floor the robot stands on)
+	 * with fewer samples give no evidence. The lower floor past a downward
+	 * step or a hole's bottom is seen at grazing incidence like the floor
+	 * itself: 4 m away a cell of it holds one or two samples, and each such
+	 * cell is the only sign of a fall there (min_obstacle_points = 3 for
+	 * drops cut the approach range of a 5 cm step 4.40 -> 3.70 m). */
+	int min_drop_points = 2;
 	/** Voxels whose bottom is more than this above the ground do not block
 	 * (ceiling, door frames, beams above the robot). [m] */
 	double robot_height = 1.8;
@@ -147,6 +161,12 @@ struct IsmParams
 				"min_obstacle_points", 1, 1000000,
 				"obstacle/drop voxels with fewer samples are ignored (depth spikes)"},
 			p.min_obstacle_points);
+		visit(
+			ParamInfo{
+				"min_drop_points", 1, 1000000,
+				"drop voxels below the ground plane with fewer samples are ignored (below a patch: "
+				"min_obstacle_points)"},
+			p.min_drop_points);
 		visit(
 			ParamInfo{
 				"measure_floor_noise", 0, 1,
@@ -262,7 +282,7 @@ enum class VoxelClass : uint8_t
 struct IsmStats
 {
 	size_t ground = 0, obstacle = 0, drop = 0, overhead = 0, out_of_range = 0;
-	size_t sparse = 0;  ///< obstacle/drop voxels below min_obstacle_points: ignored
+	size_t sparse = 0;  ///< obstacle/drop voxels below min_obstacle_points / min_drop_points: ignored
 	size_t drop_ray_cells = 0;
 	size_t drop_rays_unsupported = 0;  ///< drop rays not cast: an obstacle stood between the sensor and the crossing
 	size_t deep_drops = 0;             ///< drops found by the deep-sample count alone
@@ -337,6 +357,12 @@ class InverseSensorModel
 	const Plane& choosePlane(const GroundDetection& det, const ElevationCell& c, double x, double y, int block) const;
 	/** P(occ) of an obstacle or drop voxel: eq. (4)-(5) of its density. */
 	float obstacleEvidence(const ElevationCell& c, double resolution) const;
+	/** Samples an obstacle (min_obstacle_points) or a drop (min_drop_points) needs. */
+	uint32_t minPoints(VoxelClass c, bool onPatch) const
+	{
+		return uint32_t(
+			std::max(1, c == VoxelClass::Drop && !onPatch ? m_params.min_drop_points : m_params.min_obstacle_points));
+	}
 	void buildSupport(const GridGeometry& g, const GroundDetection& det);
 	/** deep_sample_test: counts each candidate cell's kept samples below its
 	 * threshold, then turns the cells that pass into drops. */
@@ -383,6 +409,7 @@ class InverseSensorModel
 		uint32_t cell;
 		TailKind kind;
 		float p0;
+		bool onPatch;  ///< judged against a ramp or landing patch (minPoints)
 	};
 	std::vector<TailCandidate> m_tailCandidates;
 	std::vector<float> m_tailLo, m_tailHi;
