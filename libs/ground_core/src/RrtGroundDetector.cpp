@@ -101,6 +101,7 @@ bool RrtGroundDetector::childAt(
 	child.y = float(py);
 	child.z = float(pl.heightAt(px, py));
 	child.local = pl;
+	child.fit_rms = float(rms);
 	child.parent = parentIdx;
 	return true;
 }
@@ -141,6 +142,7 @@ bool RrtGroundDetector::findSeed(const ElevationGrid& grid, const GroundSeedHint
 		seed.y = float(g.cy(cy));
 		seed.z = float(pl.heightAt(seed.x, seed.y));
 		seed.local = pl;
+		seed.fit_rms = float(rms);
 		seed.parent = -1;
 		return true;
 	}
@@ -546,6 +548,7 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 		node.y = float(py);
 		node.z = float(pl.heightAt(px, py));
 		node.local = pl;
+		node.fit_rms = float(rms);
 		node.parent = parent;
 		addTreeNode(g, node, cx, cy, out);
 		window.add(px, py);
@@ -662,6 +665,43 @@ void RrtGroundDetector::keepLargestCluster(const std::vector<Eigen::Vector3d>& p
 	if (refined && refined->horizontalNormal() <= rp.max_horizontal_normal) m_ransac.plane = *refined;
 }
 
+void RrtGroundDetector::dropCreaseNodes(
+	const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp)
+{
+	// A patch's nodes lie on it and measured its tilt. A node whose own local
+	// plane parts from the patch by more than the inlier distance across its
+	// fit window, beyond 3 sigma of its own slope, sits on a crease (the end
+	// of a landing next to a ramp): its centre is within the band, but it
+	// bends the refit toward the surface next to it (the far side of an 8 deg
+	// ramp came out at 4.5-5 deg, with the landing's last row of nodes in it).
+	// Those nodes leave the patch. The slope's sigma of a least-squares fit
+	// over the s_x x s_y cells d_r apart: rms / sqrt(sum (x - mean)^2), the
+	// sum = s_y d_r^2 h (h + 1) (2h + 1) / 3 along x for h = (s_x - 1) / 2
+	// (6 d_r^2 for 3 x 3); the smaller of the two axes.
+	std::vector<size_t>& in = m_ransac.inliers;
+	const int sx = m_params.neighbourhood_x, sy = m_params.neighbourhood_y;
+	const double window = std::max(sx, sy) * m_resolution;
+	auto spreadAlong = [&](int s, int other) {
+		const double h = (s - 1) / 2;
+		return m_resolution * std::sqrt(double(other) * h * (h + 1) * (2 * h + 1) / 3.0);
+	};
+	const double spread = std::min(spreadAlong(sx, sy), spreadAlong(sy, sx));
+	const Eigen::Vector3d n = m_ransac.plane.normal();
+	size_t w = 0;
+	for (size_t i : in)
+	{
+		const GroundNode& node = out.nodes[m_remaining[i]];
+		const double maxSine = rp.inlier_distance / window + 3.0 * double(node.fit_rms) / spread;
+		if (node.local.normal().cross(n).norm() <= maxSine) in[w++] = i;
+	}
+	if (w == in.size() || w < 3) return;
+	in.resize(w);
+	m_ransacInliers.clear();
+	for (size_t i : in) m_ransacInliers.push_back(pts[i]);
+	const auto refined = fitPlaneTotalLeastSquares(m_ransacInliers);
+	if (refined && refined->horizontalNormal() <= rp.max_horizontal_normal) m_ransac.plane = *refined;
+}
+
 void RrtGroundDetector::fitPlanes(GroundDetection& out)
 {
 	// RANSAC over the node centres gives the ground plane; further RANSAC rounds
@@ -713,6 +753,7 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		if (!found) found = fitPlaneRansac(pts, rp, m_rng, m_ransac, m_ransacInliers);
 		if (!found) break;
 		if (k > 0) keepLargestCluster(pts, rp);
+		if (k > 0) dropCreaseNodes(out, pts, rp);
 		const RansacResult& r = m_ransac;
 		if (r.inliers.size() < std::max<size_t>(3, rp.min_inliers))
 		{

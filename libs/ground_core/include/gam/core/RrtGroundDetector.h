@@ -122,6 +122,7 @@ struct GroundNode
 {
 	float x = 0, y = 0, z = 0;  ///< centre (cell centre, surface height)
 	Plane local;                ///< least-squares plane of its s_x * s_y neighbourhood
+	float fit_rms = 0;          ///< RMS residual of that fit [m]
 	int parent = -1;
 	int plane_id = -1;  ///< index into GroundDetection::planes, -1 = none
 };
@@ -262,6 +263,10 @@ class RrtGroundDetector
 	/** Keeps, of m_ransac's inliers, the largest group linked by steps of at
 	 * most d_n, and refits its plane (see fitPlanes). */
 	void keepLargestCluster(const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
+	/** Drops from m_ransac's inliers the nodes whose local plane parts from
+	 * the patch across a fit window by more than the inlier distance and the
+	 * noise of their own slope (a crease), and refits (see fitPlanes). */
+	void dropCreaseNodes(const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
 	/** 3 sigma of the distances in m_absDist (robust) + the cell quantisation
 	 * d_r / 2 * tan(asin N_th), at most `cap` (see fitPlanes). */
 	double noiseBand(double cap);
