@@ -687,15 +687,16 @@ void RrtGroundDetector::dropCreaseNodes(
 	};
 	const double spread = std::min(spreadAlong(sx, sy), spreadAlong(sy, sx));
 	const Eigen::Vector3d n = m_ransac.plane.normal();
-	size_t w = 0;
-	for (size_t i : in)
-	{
+	auto onCrease = [&](size_t i) {
 		const GroundNode& node = out.nodes[m_remaining[i]];
 		const double maxSine = rp.inlier_distance / window + 3.0 * double(node.fit_rms) / spread;
-		if (node.local.normal().cross(n).norm() <= maxSine) in[w++] = i;
-	}
-	if (w == in.size() || w < 3) return;
-	in.resize(w);
+		return node.local.normal().cross(n).norm() > maxSine;
+	};
+	// Decide before compacting: a patch left with fewer than 3 nodes keeps
+	// them all.
+	const size_t kept = size_t(std::count_if(in.begin(), in.end(), [&](size_t i) { return !onCrease(i); }));
+	if (kept == in.size() || kept < 3) return;
+	in.erase(std::remove_if(in.begin(), in.end(), onCrease), in.end());
 	m_ransacInliers.clear();
 	for (size_t i : in) m_ransacInliers.push_back(pts[i]);
 	const auto refined = fitPlaneTotalLeastSquares(m_ransacInliers);
