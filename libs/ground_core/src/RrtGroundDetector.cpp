@@ -97,12 +97,7 @@ bool RrtGroundDetector::childAt(
 	Plane pl;
 	double rms;
 	if (!fitLocalPlane(grid, cx, cy, pl, rms) || !planarEnough(pl, rms)) return false;
-	child.x = float(px);
-	child.y = float(py);
-	child.z = float(pl.heightAt(px, py));
-	child.local = pl;
-	child.fit_rms = float(rms);
-	child.parent = parentIdx;
+	child = GroundNode::fromFit(px, py, pl, rms, parentIdx);
 	return true;
 }
 
@@ -138,12 +133,7 @@ bool RrtGroundDetector::findSeed(const ElevationGrid& grid, const GroundSeedHint
 		Plane pl;
 		double rms;
 		if (!fitLocalPlane(grid, cx, cy, pl, rms) || !planarEnough(pl, rms)) continue;
-		seed.x = float(g.cx(cx));
-		seed.y = float(g.cy(cy));
-		seed.z = float(pl.heightAt(seed.x, seed.y));
-		seed.local = pl;
-		seed.fit_rms = float(rms);
-		seed.parent = -1;
+		seed = GroundNode::fromFit(g.cx(cx), g.cy(cy), pl, rms, -1);
 		return true;
 	}
 	return false;
@@ -543,14 +533,7 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 				}
 		}
 		if (parent < 0) continue;
-		GroundNode node;
-		node.x = float(px);
-		node.y = float(py);
-		node.z = float(pl.heightAt(px, py));
-		node.local = pl;
-		node.fit_rms = float(rms);
-		node.parent = parent;
-		addTreeNode(g, node, cx, cy, out);
+		addTreeNode(g, GroundNode::fromFit(px, py, pl, rms, parent), cx, cy, out);
 		window.add(px, py);
 	}
 }
@@ -653,14 +636,16 @@ void RrtGroundDetector::keepLargestCluster(const std::vector<Eigen::Vector3d>& p
 	}
 	if (nClusters <= 1) return;
 	size_t w = 0;
-	m_ransacInliers.clear();
 	for (size_t i = 0; i < n; i++)
-		if (m_cluster[i] == best)
-		{
-			in[w++] = in[i];
-			m_ransacInliers.push_back(pts[in[i]]);
-		}
+		if (m_cluster[i] == best) in[w++] = in[i];
 	in.resize(w);
+	refitToInliers(pts, rp);
+}
+
+void RrtGroundDetector::refitToInliers(const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp)
+{
+	m_ransacInliers.clear();
+	for (size_t i : m_ransac.inliers) m_ransacInliers.push_back(pts[i]);
 	const auto refined = fitPlaneTotalLeastSquares(m_ransacInliers);
 	if (refined && refined->horizontalNormal() <= rp.max_horizontal_normal) m_ransac.plane = *refined;
 }
@@ -697,10 +682,7 @@ void RrtGroundDetector::dropCreaseNodes(
 	const size_t kept = size_t(std::count_if(in.begin(), in.end(), [&](size_t i) { return !onCrease(i); }));
 	if (kept == in.size() || kept < 3) return;
 	in.erase(std::remove_if(in.begin(), in.end(), onCrease), in.end());
-	m_ransacInliers.clear();
-	for (size_t i : in) m_ransacInliers.push_back(pts[i]);
-	const auto refined = fitPlaneTotalLeastSquares(m_ransacInliers);
-	if (refined && refined->horizontalNormal() <= rp.max_horizontal_normal) m_ransac.plane = *refined;
+	refitToInliers(pts, rp);
 }
 
 void RrtGroundDetector::fitPlanes(GroundDetection& out)

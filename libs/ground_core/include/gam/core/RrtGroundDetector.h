@@ -125,6 +125,20 @@ struct GroundNode
 	float fit_rms = 0;          ///< RMS residual of that fit [m]
 	int parent = -1;
 	int plane_id = -1;  ///< index into GroundDetection::planes, -1 = none
+
+	/** The node at cell centre (x, y) whose local fit is `local` (RMS `rms`):
+	 * its height is that plane's there. */
+	static GroundNode fromFit(double x, double y, const Plane& local, double rms, int parent)
+	{
+		GroundNode n;
+		n.x = float(x);
+		n.y = float(y);
+		n.z = float(local.heightAt(x, y));
+		n.local = local;
+		n.fit_rms = float(rms);
+		n.parent = parent;
+		return n;
+	}
 };
 
 struct GroundDetection
@@ -263,6 +277,9 @@ class RrtGroundDetector
 	/** Keeps, of m_ransac's inliers, the largest group linked by steps of at
 	 * most d_n, and refits its plane (see fitPlanes). */
 	void keepLargestCluster(const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
+	/** Refits m_ransac.plane (total least squares) to the points of its
+	 * inliers, unless that plane tilts beyond N_th. */
+	void refitToInliers(const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
 	/** Drops from m_ransac's inliers the nodes whose local plane parts from
 	 * the patch across a fit window by more than the inlier distance and the
 	 * noise of their own slope (a crease), and refits (see fitPlanes). */
