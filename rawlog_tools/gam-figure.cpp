@@ -234,7 +234,7 @@ void paperMode(CGroundAwareOccupancyGrid::TGroundAwareOptions& o)
 {
 	o.pipeline.ism.model = gam::MethodVariant::Paper;
 	o.pipeline.rrt.variant = gam::MethodVariant::Paper;
-	o.scan_keeps_3d_obstacles = false;
+	o.scan_keeps_3d_obstacles = CGroundAwareOccupancyGrid::TGroundAwareOptions::ScanRule::BeamModel;
 }
 
 /** One line per map: occupied / free cells in the view; with a ground truth
@@ -361,7 +361,9 @@ int figure5(
 	if (!gtPrefix.empty()) gt = std::make_unique<gam::eval::GroundTruth>(gam::eval::loadGroundTruth(gtPrefix));
 	CGroundAwareOccupancyGrid paper = cfg.groundAware, ours = cfg.groundAware, leddar = cfg.groundAware;
 	applyOptions(paper, paperMode);
-	applyOptions(leddar, [](auto& o) { o.scan_keeps_3d_obstacles = false; });  // MRPT's beam model
+	applyOptions(leddar, [](auto& o) {
+		o.scan_keeps_3d_obstacles = CGroundAwareOccupancyGrid::TGroundAwareOptions::ScanRule::BeamModel;
+	});  // MRPT's beam model
 	CHeightBandOccupancyGrid band = cfg.heightBand;
 	std::vector<std::pair<double, double>> path;
 	size_t depthFrames = 0, scans = 0;

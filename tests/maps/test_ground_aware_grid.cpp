@@ -199,24 +199,65 @@ TEST(GroundAwareGrid, EvidenceAccumulatesOverFrames)
 	EXPECT_LT(pOcc(g, 1.0, -0.5), f1);
 }
 
+namespace
+{
+using ScanRule = CGroundAwareOccupancyGrid::TGroundAwareOptions::ScanRule;
+
+void setScanRule(CGroundAwareOccupancyGrid& g, ScanRule r)
+{
+	auto o = g.groundOptions();
+	o.scan_keeps_3d_obstacles = r;
+	g.setGroundOptions(o);
+}
+}  // namespace
+
 TEST(GroundAwareGrid, LeddarScanFusesThroughTheBeamModel)
 {
 	const auto s = leddarWallScan();
-	CGroundAwareOccupancyGrid g, plain;
-	auto beamModel = plain.groundOptions();
-	beamModel.scan_keeps_3d_obstacles = false;
-	plain.setGroundOptions(beamModel);
-	ASSERT_TRUE(g.insertObservation(s));
+	CGroundAwareOccupancyGrid walker, plain;
+	setScanRule(walker, ScanRule::KeepCameraFloor);
+	setScanRule(plain, ScanRule::BeamModel);
+	ASSERT_TRUE(walker.insertObservation(s));
 	ASSERT_TRUE(plain.insertObservation(s));
-	for (const auto* m : {&g, &plain})
+	for (const auto* m : {&walker, &plain})
 	{
 		EXPECT_GT(pOccNear(*m, 3.0, 0.0), 0.6);
 		EXPECT_GT(pOccNear(*m, 3.0, 0.9), 0.6) << "edge segment covered (upsampled beams)";
 	}
-	// The plain beam model frees the space before the wall; by default a
-	// planar scan does not turn unknown floor into free floor.
+	// The plain beam model frees the space before the wall; with the walker's
+	// rule a planar scan does not turn unknown floor into free floor.
 	EXPECT_LT(pOcc(plain, 1.5, 0.0), 0.4);
-	EXPECT_NEAR(pOcc(g, 1.5, 0.0), 0.5, 1e-3);
+	EXPECT_NEAR(pOcc(walker, 1.5, 0.0), 0.5, 1e-3);
+}
+
+TEST(GroundAwareGrid, AutoScanRuleIsTheBeamModelUntilTheFirstDepthFrame)
+{
+	// Issue #31: the default (auto) serves a lidar-only user and the walker.
+	const auto s = leddarWallScan();
+	CGroundAwareOccupancyGrid automatic, plain;
+	ASSERT_EQ(automatic.groundOptions().scan_keeps_3d_obstacles, ScanRule::Auto);
+	setScanRule(plain, ScanRule::BeamModel);
+	EXPECT_FALSE(automatic.scanRuleActive());
+	automatic.insertObservation(s);
+	plain.insertObservation(s);
+	EXPECT_EQ(automatic.getRawMap(), plain.getRawMap()) << "no depth frame yet: the stock beam model, cell for cell";
+	EXPECT_LT(pOcc(automatic, 1.5, 0.0), 0.4);
+
+	// After one depth frame the walker's rule holds: a scan frees nothing.
+	automatic.insertObservation(*testscene::renderDepth(holeAndBoxScene(), kKinect));
+	EXPECT_EQ(automatic.depthFramesReceived(), 1u);
+	EXPECT_TRUE(automatic.scanRuleActive());
+	const auto before = automatic.getRawMap();
+	automatic.insertObservation(s);
+	const auto& after = automatic.getRawMap();
+	ASSERT_EQ(before.size(), after.size());
+	size_t freer = 0;
+	for (size_t i = 0; i < before.size(); i++) freer += after[i] > before[i];
+	EXPECT_EQ(freer, 0u) << "cells made freer by a 2D scan after a depth frame";
+	// clear() starts over: the grid is a stock grid again until its next depth frame.
+	automatic.clear();
+	EXPECT_EQ(automatic.depthFramesReceived(), 0u);
+	EXPECT_FALSE(automatic.scanRuleActive());
 }
 
 TEST(GroundAwareGrid, LeddarSegmentEchoStaysInItsOwnCone)
@@ -265,9 +306,7 @@ TEST(GroundAwareGrid, LeddarBeamsOverAHoleDoNotClearIt)
 	for (bool keep : {true, false})
 	{
 		CGroundAwareOccupancyGrid g;
-		auto o = g.groundOptions();
-		o.scan_keeps_3d_obstacles = keep;
-		g.setGroundOptions(o);
+		setScanRule(g, keep ? ScanRule::KeepCameraFloor : ScanRule::BeamModel);
 		g.insertObservation(*testscene::renderDepth(scene, kKinect));
 		const double hole = pOcc(g, 2.2, 0.0), box = pOcc(g, 1.6, 0.7), floor = pOcc(g, 1.0, 0.0);
 		ASSERT_GT(hole, 0.7);
@@ -319,6 +358,7 @@ TEST(GroundAwareGrid, LeddarScansTakeBackOnlyTheirOwnHits)
 		return s;
 	};
 	CGroundAwareOccupancyGrid g(-5, 5, -5, 5, 0.05f);
+	setScanRule(g, ScanRule::KeepCameraFloor);         // no depth frame here: auto would be the beam model
 	const int ux = g.x2idx(1.0f), uy = g.y2idx(1.0f);  // (1, 1): 1.41 m, inside both arcs
 	g.setCell(unsigned(ux), unsigned(uy), 0.1f);       // occupied, not by a scan
 	const float marked = g.getCell(unsigned(ux), unsigned(uy));

@@ -87,14 +87,52 @@ outlier_filter=false
 	EXPECT_EQ(mm.countMapsByClass<COccupancyGridMap2D>(), 2u);
 }
 
-TEST(IniConstruction, LeddarNoReturnIsNotFreeSpaceFromIniEither)
+TEST(IniConstruction, StockInsertionDefaultsAndTheWalkersLeddarSetting)
 {
+	// Issue #31: the stock options keep the stock defaults (an .ini written for
+	// COccupancyGridMap2D means the same here) ...
 	CMultiMetricMap mm(initsFrom("[map]\ngroundAwareGrid_count=1\n"));
-	EXPECT_FALSE(mm.mapByClass<CGroundAwareOccupancyGrid>()->insertionOptions.considerInvalidRangesAsFreeSpace);
-	CMultiMetricMap explicitOn(
-		initsFrom("[map]\ngroundAwareGrid_count=1\n[map_groundAwareGrid_00_insertOpts]"
-				  "\nconsiderInvalidRangesAsFreeSpace=true\n"));
-	EXPECT_TRUE(explicitOn.mapByClass<CGroundAwareOccupancyGrid>()->insertionOptions.considerInvalidRangesAsFreeSpace);
+	EXPECT_TRUE(mm.mapByClass<CGroundAwareOccupancyGrid>()->insertionOptions.considerInvalidRangesAsFreeSpace);
+	EXPECT_TRUE(CGroundAwareOccupancyGrid().insertionOptions.considerInvalidRangesAsFreeSpace);
+	// ... and the walker's configs say that a Leddar "no return" is not free space.
+	for (const char* f : {"/config/ground-aware-grid.ini", "/config/ground-aware-mapper.ini"})
+	{
+		mrpt::config::CConfigFile cfg(std::string(GAM_SOURCE_DIR) + f);
+		TSetOfMetricMapInitializers inits;
+		inits.loadFromConfigFile(cfg, "map");
+		CMultiMetricMap walker(inits);
+		ASSERT_TRUE(walker.mapByClass<CGroundAwareOccupancyGrid>()) << f;
+		EXPECT_FALSE(walker.mapByClass<CGroundAwareOccupancyGrid>()->insertionOptions.considerInvalidRangesAsFreeSpace)
+			<< f;
+		EXPECT_EQ(
+			walker.mapByClass<CGroundAwareOccupancyGrid>()->groundOptions().scan_keeps_3d_obstacles,
+			CGroundAwareOccupancyGrid::TGroundAwareOptions::ScanRule::KeepCameraFloor)
+			<< f;
+	}
+}
+
+TEST(IniConstruction, ScanRuleTakesItsNamesAndTheOldBooleans)
+{
+	using R = CGroundAwareOccupancyGrid::TGroundAwareOptions::ScanRule;
+	const std::vector<std::pair<std::string, R>> cases = {
+		{"auto", R::Auto},       {"true", R::KeepCameraFloor}, {"1", R::KeepCameraFloor}, {"yes", R::KeepCameraFloor},
+		{"false", R::BeamModel}, {"0", R::BeamModel},          {"OFF", R::BeamModel}};
+	for (const auto& [text, want] : cases)
+	{
+		CMultiMetricMap m(initsFrom(
+			"[map]\ngroundAwareGrid_count=1\n[map_groundAwareGrid_00_groundOpts]\nscan_keeps_3d_obstacles=" + text +
+			"\n"));
+		EXPECT_EQ(m.mapByClass<CGroundAwareOccupancyGrid>()->groundOptions().scan_keeps_3d_obstacles, want) << text;
+	}
+	try
+	{
+		initsFrom("[map]\ngroundAwareGrid_count=1\n[map_groundAwareGrid_00_groundOpts]\nscan_keeps_3d_obstacles=2\n");
+		ADD_FAILURE() << "scan_keeps_3d_obstacles=2 was accepted";
+	}
+	catch (const std::exception& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("false | true | auto"), std::string::npos) << e.what();
+	}
 }
 
 TEST(IniConstruction, DefaultsAreThePaperTableI)
@@ -142,7 +180,15 @@ TEST(IniConstruction, ExampleConfigLoadsWithTableIValues)
 	Options::forEachParam(
 		ref.groundOptions(), [&](const gam::ParamInfo&, const auto& v) { defaults.push_back(double(v)); });
 	ASSERT_EQ(loaded.size(), defaults.size());
-	for (size_t i = 0; i < loaded.size(); i++) EXPECT_DOUBLE_EQ(loaded[i], defaults[i]) << names[i];
+	for (size_t i = 0; i < loaded.size(); i++)
+	{
+		// The walker's example has a Leddar that may start before its camera,
+		// so it sets the scan rule on from the first scan (default: auto).
+		if (names[i] == "scan_keeps_3d_obstacles")
+			EXPECT_DOUBLE_EQ(loaded[i], double(Options::ScanRule::KeepCameraFloor));
+		else
+			EXPECT_DOUBLE_EQ(loaded[i], defaults[i]) << names[i];
+	}
 	for (const char* k :
 		 {"K", "N_th", "E_th", "s_x", "s_y", "m_x", "m_y", "d_n", "d_pth", "K_g", "sigma2", "K_n", "d_min", "K_m"})
 		EXPECT_TRUE(cfg.keyExists(sec, k)) << k << " missing in the example";

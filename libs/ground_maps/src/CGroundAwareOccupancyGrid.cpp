@@ -9,8 +9,10 @@
 #include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -22,6 +24,10 @@ IMPLEMENTS_SERIALIZABLE(CGroundAwareOccupancyGrid, COccupancyGridMap2D, mrpt::ma
 
 namespace
 {
+// 2D scans without a depth frame before the "no free space" warning: a walker
+// whose Leddar starts before its camera stays below it.
+constexpr uint64_t kScansBeforeWarning = 10;
+
 // What tools need to know about this class (gam/maps/MapRegistry.h).
 const bool kTraitsRegistered = [] {
 	gam::maps::MapTraits t;
@@ -117,12 +123,12 @@ const bool kTraitsRegistered = [] {
 }();
 }  // namespace
 
-CGroundAwareOccupancyGrid::TMapDefinition::TMapDefinition()
-{
-	// As the constructor: a Leddar "no return" is not free space (an .ini
-	// key in _insertOpts still overrides it).
-	insertionOpts.considerInvalidRangesAsFreeSpace = false;
-}
+// The stock options keep the stock defaults (considerInvalidRangesAsFreeSpace
+// = true among them), so that an .ini written for COccupancyGridMap2D means
+// the same here; the walker's .ini files set what a Leddar needs (a "no
+// return" is not free space). Only the resolution differs: 0.05 m, the
+// paper's d_r, against the stock .ini default of 0.10 m.
+CGroundAwareOccupancyGrid::TMapDefinition::TMapDefinition() = default;
 
 void CGroundAwareOccupancyGrid::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
@@ -192,10 +198,52 @@ CGroundAwareOccupancyGrid::CGroundAwareOccupancyGrid(
 	float min_x, float max_x, float min_y, float max_y, float resolution)
 	: COccupancyGridMap2D(min_x, max_x, min_y, max_y, resolution)
 {
-	// Converted depth scans and Leddar segments report "no return" often;
-	// that is not evidence of free space.
-	insertionOptions.considerInvalidRangesAsFreeSpace = false;
+	// The stock insertion and likelihood defaults (see TMapDefinition).
 }
+
+void CGroundAwareOccupancyGrid::resetRunState()
+{
+	m_missingLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
+	m_scanOnlyLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
+	m_positiveSeen.clear();
+	m_mounts.clear();
+	m_depthFrames = 0;
+	m_scansBeforeDepth = 0;
+	m_warnedNoFreeSpace = false;
+}
+
+void CGroundAwareOccupancyGrid::internal_clear()
+{
+	COccupancyGridMap2D::internal_clear();
+	resetRunState();
+}
+
+bool CGroundAwareOccupancyGrid::scanRuleActive() const
+{
+	using R = TGroundAwareOptions::ScanRule;
+	switch (m_options.scan_keeps_3d_obstacles)
+	{
+		case R::KeepCameraFloor: return true;
+		case R::Auto: return m_depthFrames > 0;
+		default: return false;
+	}
+}
+
+void CGroundAwareOccupancyGrid::loadFromStockGrid(const COccupancyGridMap2D& stock)
+{
+	setSize(stock.getXMin(), stock.getXMax(), stock.getYMin(), stock.getYMax(), stock.getResolution(), 0.5f);
+	// setSize rounds the cell count the way the stock grid's own setSize did,
+	// so the two have the same size; copy row by row all the same.
+	const unsigned w = std::min(getSizeX(), stock.getSizeX()), h = std::min(getSizeY(), stock.getSizeY());
+	for (unsigned cy = 0; cy < h; cy++) std::copy_n(stock.getRow(int(cy)), w, getRow(int(cy)));
+	// (A deserialized stock grid reports isEmpty() whatever its cells hold:
+	// the flag is not serialized. A cell that is not unknown decides.)
+	m_is_empty = stock.isEmpty() && std::all_of(m_map.begin(), m_map.end(), [](cellType c) { return c == 0; });
+	m_likelihoodCacheOutDated = true;
+	resetRunState();
+}
+
+COccupancyGridMap2D CGroundAwareOccupancyGrid::asStockGrid() const { return COccupancyGridMap2D(*this); }
 
 std::string CGroundAwareOccupancyGrid::asString() const
 {
@@ -248,7 +296,17 @@ bool CGroundAwareOccupancyGrid::insert2D(
 	const auto up =
 		sparse ? upsampleSparseScan(scan, m_options.sparse_scan_upsampling) : mrpt::obs::CObservation2DRangeScan();
 	const auto& use = sparse ? up : scan;
-	if (!m_options.scan_keeps_3d_obstacles) return COccupancyGridMap2D::internal_insertObservation(use, robotPose);
+	if (m_depthFrames == 0 && ++m_scansBeforeDepth >= kScansBeforeWarning && !m_warnedNoFreeSpace && scanRuleActive())
+	{
+		// A lidar-only grid with the walker's rule would never get a free cell
+		// (MRPT's localization then aborts on "nFreeCells"): say so, once.
+		m_warnedNoFreeSpace = true;
+		std::cerr << "[CGroundAwareOccupancyGrid] warning: " << m_scansBeforeDepth
+				  << " 2D scans and no depth frame: with scan_keeps_3d_obstacles=true 2D scans free no cell, so "
+					 "this grid has no free space; for a lidar-only grid set scan_keeps_3d_obstacles=auto (the "
+					 "default) or false\n";
+	}
+	if (!scanRuleActive()) return COccupancyGridMap2D::internal_insertObservation(use, robotPose);
 
 	// A planar beam sees only its own height: passing over a hole, a cable or
 	// a 5 cm box says nothing about the floor. So the beam model adds its hits
@@ -274,12 +332,14 @@ bool CGroundAwareOccupancyGrid::insert2D(
 	syncLayer(m_scanOnlyLayer);
 	cellType* scanOnly = m_scanOnlyLayer.getRow(0);
 	const cellType kScanOnly = std::numeric_limits<cellType>::min();
-	for (int cy = 0; cy < sy0; cy++)
-		for (int cx = 0; cx < sx0; cx++)
+	// Every cell of the grid as it is now: a cell the scan grew the grid by was
+	// unknown before it (a scan that grew the grid used to free those cells).
+	for (int ny = 0; ny < sy; ny++)
+		for (int nx = 0; nx < sx; nx++)
 		{
-			const cellType old = before[size_t(cy) * size_t(sx0) + size_t(cx)];
-			const int nx = cx + ox, ny = cy + oy;
-			if (nx < 0 || ny < 0 || nx >= sx || ny >= sy) continue;
+			const int cx = nx - ox, cy = ny - oy;
+			const bool wasThere = cx >= 0 && cy >= 0 && cx < sx0 && cy < sy0;
+			const cellType old = wasThere ? before[size_t(cy) * size_t(sx0) + size_t(cx)] : cellType(0);
 			const size_t i = size_t(ny) * size_t(sx) + size_t(nx);
 			cellType& now = m_map[i];
 			if (now > old)
@@ -298,6 +358,7 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 	const auto t0 = clk::now();
 	m_pipeline.resetResult();
 	m_times = TFrameTimes{};
+	m_depthFrames++;
 
 	// Adapt the observation once (samples and sensor pose), run the method on
 	// a frame grid aligned with this grid's cells, fuse its evidence.
@@ -532,7 +593,8 @@ void CGroundAwareOccupancyGrid::applyEvidence()
 // Serialization: v0 = base grid (with its own version) + groundOptions as
 // (key, value) pairs, so options added later read back old files.
 // v1 = v0 + the missing-floor layer (a plain COccupancyGridMap2D).
-uint8_t CGroundAwareOccupancyGrid::serializeGetVersion() const { return 1; }
+// v2 = v1 + the number of depth frames received (scan_keeps_3d_obstacles = auto).
+uint8_t CGroundAwareOccupancyGrid::serializeGetVersion() const { return 2; }
 
 void CGroundAwareOccupancyGrid::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -541,6 +603,7 @@ void CGroundAwareOccupancyGrid::serializeTo(mrpt::serialization::CArchive& out) 
 	gam::maps::ini::write(m_options, out);
 	syncMissingLayer();
 	out << m_missingLayer;
+	out << m_depthFrames;
 }
 
 void CGroundAwareOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version)
@@ -548,7 +611,8 @@ void CGroundAwareOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in,
 	switch (version)
 	{
 		case 0:
-		case 1: {
+		case 1:
+		case 2: {
 			uint8_t baseVer;
 			in >> baseVer;
 			COccupancyGridMap2D::serializeFrom(in, baseVer);
@@ -558,6 +622,14 @@ void CGroundAwareOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in,
 			m_missingLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
 			if (version >= 1) in >> m_missingLayer;
 			syncMissingLayer();
+			m_scanOnlyLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
+			m_positiveSeen.clear();
+			m_scansBeforeDepth = 0;
+			m_warnedNoFreeSpace = false;
+			// A map saved before v2 was made by this class's walker rule as it
+			// then was (always on): it counts as having seen depth frames.
+			m_depthFrames = 1;
+			if (version >= 2) in >> m_depthFrames;
 		}
 		break;
 		default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);

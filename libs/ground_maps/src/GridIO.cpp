@@ -4,6 +4,8 @@
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -185,6 +187,46 @@ COccupancyGridMap2D readGridmapGz(const std::string& path)
 	auto ar = mrpt::serialization::archiveFrom(f);
 	ar >> g;
 	return g;
+}
+
+COccupancyGridMap2D readStockGrid(const std::string& path)
+{
+	const auto endsWith = [&](const char* ext) {
+		const std::string e(ext);
+		return path.size() >= e.size() && std::equal(e.rbegin(), e.rend(), path.rbegin(), [](char a, char b) {
+				   return std::tolower(static_cast<unsigned char>(a)) == b;
+			   });
+	};
+	COccupancyGridMap2D g;
+	if (endsWith(".yaml") || endsWith(".yml"))
+	{
+		if (!std::ifstream(path)) throw std::runtime_error("cannot open " + path);
+		// MRPT prints the reason on stderr and returns false.
+		if (!g.loadFromROSMapServerYAML(path))
+			throw std::runtime_error(
+				path +
+				": not a ROS map_server map (needs image, resolution, origin, occupied_thresh, free_thresh, "
+				"negate; see the message above)");
+		return g;
+	}
+	mrpt::io::CFileGZInputStream f;
+	if (!f.open(path)) throw std::runtime_error("cannot open " + path);
+	mrpt::serialization::CSerializable::Ptr obj;
+	try
+	{
+		auto ar = mrpt::serialization::archiveFrom(f);
+		obj = ar.ReadObject();
+	}
+	catch (const std::exception& e)
+	{
+		throw std::runtime_error(
+			path + ": not a serialized MRPT object (" + std::string(e.what()).substr(0, 200) + ")");
+	}
+	const auto* grid = dynamic_cast<const COccupancyGridMap2D*>(obj.get());
+	if (!grid)
+		throw std::runtime_error(
+			path + " holds a " + obj->GetRuntimeClass()->className + ", not an occupancy grid (COccupancyGridMap2D)");
+	return COccupancyGridMap2D(*grid);  // a derived class: its grid part
 }
 
 void writeSerializedGz(const mrpt::serialization::CSerializable& obj, const std::string& path)

@@ -57,6 +57,13 @@ int parseChoice(const std::string& raw, const ParamInfo& info, const std::string
 		if (gam::iequals(raw, info.choices[i])) return i;
 		names += (i ? " | " : "") + std::string(info.choices[i]);
 	}
+	// A choice that grew out of a boolean (false | true | ...) keeps taking
+	// the boolean spellings its .ini files were written with (0, 1, yes, off).
+	const std::string l = gam::toLower(raw);
+	const bool boolLike = info.choices && info.choices[0] && info.choices[1] &&
+						  std::string(info.choices[0]) == "false" && std::string(info.choices[1]) == "true";
+	if (boolLike && (l == "1" || l == "yes" || l == "on")) return 1;
+	if (boolLike && (l == "0" || l == "no" || l == "off")) return 0;
 	throw std::invalid_argument(context + " " + info.key + "=" + raw + " is not one of " + names);
 }
 

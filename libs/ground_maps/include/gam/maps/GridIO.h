@@ -71,7 +71,17 @@ bool recentreGrid(mrpt::maps::COccupancyGridMap2D& grid, double cx, double cy, i
 // --------------------------------------------------------------- readers
 // (map_server yaml + PGM: gam::eval::loadRosMap in libs/ground_eval.)
 
-/** Reads a .gridmap / .gridmap.gz as a stock COccupancyGridMap2D. */
+/** Reads a .gridmap / .gridmap.gz as a stock COccupancyGridMap2D, exactly as
+ * a stock MRPT tool does (`archive >> COccupancyGridMap2D`): a file holding a
+ * derived class (a serialized CGroundAwareOccupancyGrid) is refused. */
 mrpt::maps::COccupancyGridMap2D readGridmapGz(const std::string& path);
+
+/** Reads any stock grid file into a plain COccupancyGridMap2D:
+ * - `*.yaml`: a ROS map_server map (COccupancyGridMap2D::loadFromROSMapServerYAML:
+ *   `mode: scale` reads each pixel as P(free), `trinary` by the thresholds);
+ * - anything else (`.gridmap`, `.gridmap.gz`): one serialized COccupancyGridMap2D
+ *   or any class derived from it (its COccupancyGridMap2D part).
+ * Throws std::runtime_error naming the file and what is wrong with it. */
+mrpt::maps::COccupancyGridMap2D readStockGrid(const std::string& path);
 
 }  // namespace gam::maps

@@ -27,7 +27,8 @@ std::string readRaw(const mrpt::config::CConfigFileBase& src, const std::string&
  * integer", or the range error of checkParamRange. */
 bool parseBool(const std::string& raw, const ParamInfo& info, const std::string& context);
 double parseNumber(const std::string& raw, const ParamInfo& info, const std::string& context, bool integer);
-/** Index of `raw` among info.choices (case-insensitive); throws
+/** Index of `raw` among info.choices (case-insensitive; a choice list that
+ * begins false, true also takes 0/1, yes/no, on/off); throws
  * std::invalid_argument "<context> key=raw is not one of a | b". */
 int parseChoice(const std::string& raw, const ParamInfo& info, const std::string& context);
 

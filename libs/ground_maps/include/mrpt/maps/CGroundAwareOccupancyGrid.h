@@ -66,15 +66,25 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		gam::PipelineParams pipeline;
 		// 2D scans
 		int sparse_scan_upsampling = 8;  ///< rays per beam for scans of < 64 beams (Leddar)
-		/** A planar beam passes over holes, cables and small boxes: with this
-		 * on, 2D scans add their hits and make no cell freer: only floor the
-		 * depth camera saw is free (off: MRPT's beam model). */
-		bool scan_keeps_3d_obstacles = true;
-		/** > 0: a positive obstacle (something sticking out of the floor, or a
-		 * 2D scan's hit) not re-observed as an obstacle for this many seconds
-		 * returns to unknown -- people who left. Never a negative obstacle
-		 * (hole, drop) or missing floor: those cannot walk away. 0 = off (the
-		 * default, as STVL's voxel_decay): obstacles stay until seen free. [s] */
+		/** What a 2D scan may do to the grid (the walker's rule, issue #31):
+		 * - `true`: a planar beam passes over holes, cables and small boxes, so
+		 *   2D scans add their hits and make no cell freer: only floor the depth
+		 *   camera saw is free. A grid that never gets a depth frame then has
+		 *   no free cell (a one-line warning says so).
+		 * - `false`: MRPT's beam model, as the stock COccupancyGridMap2D.
+		 * - `auto` (default): `false` until the grid has received its first
+		 *   depth frame (CObservation3DRangeScan or CObservationPointCloud),
+		 *   `true` from then on. A lidar-only grid is then the stock grid, cell
+		 *   for cell; the walker's configs set `true` so that Leddar scans that
+		 *   come before the first depth frame free nothing either. */
+		enum class ScanRule : int
+		{
+			BeamModel = 0,
+			KeepCameraFloor = 1,
+			Auto = 2
+		};
+		static constexpr const char* kScanRuleNames[] = {"false", "true", "auto", nullptr};
+		ScanRule scan_keeps_3d_obstacles = ScanRule::Auto;
 		double obstacle_decay_s = 0;
 		/** The online check of the declared sensor mount (height, pitch, roll)
 		 * against every frame's floor, and the option to map with the measured one. */
@@ -89,7 +99,11 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 				gam::ParamInfo{"sparse_scan_upsampling", 1, 1000, "rays per beam for scans with < 64 beams"},
 				o.sparse_scan_upsampling);
 			visit(
-				gam::ParamInfo{"scan_keeps_3d_obstacles", 0, 1, "2D scans add their hits and free no cell"},
+				gam::ParamInfo{
+					"scan_keeps_3d_obstacles", 0, 2,
+					"2D scans add their hits and free no cell: true | false (MRPT's beam model) | auto (false until "
+					"the first depth frame)",
+					kScanRuleNames},
 				o.scan_keeps_3d_obstacles);
 			visit(
 				gam::ParamInfo{
@@ -152,6 +166,28 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 
 	std::string asString() const override;
 
+	/** Depth frames (CObservation3DRangeScan, CObservationPointCloud) this
+	 * grid has received since it was created, cleared or loaded from a stock
+	 * grid (serialized). */
+	uint64_t depthFramesReceived() const { return m_depthFrames; }
+	/** Whether the next 2D scan follows the walker's rule (adds hits, frees
+	 * nothing): scan_keeps_3d_obstacles = true, or auto after a depth frame. */
+	bool scanRuleActive() const;
+
+	/** Stock grids in: this grid takes the extent, resolution and cells of
+	 * `stock` (any COccupancyGridMap2D, e.g. one read from a `.gridmap` or a
+	 * ROS map_server YAML; see gam/maps/GridIO.h readStockGrid()). Its own
+	 * options (insertion, likelihood, ground) stay; the run state (missing
+	 * floor layer, scan-only cells, obstacle ages, depth frames received) is
+	 * reset, so a lidar-made map takes 2D scans as the stock grid would until
+	 * a depth frame arrives (scan_keeps_3d_obstacles = auto). */
+	void loadFromStockGrid(const COccupancyGridMap2D& stock);
+	/** Stock grids out: a plain COccupancyGridMap2D with this grid's extent,
+	 * cells and options, which any MRPT tool reads when serialized (a
+	 * serialized CGroundAwareOccupancyGrid needs this plugin to be read, and
+	 * `archive >> COccupancyGridMap2D` rejects it: the stored class differs). */
+	COccupancyGridMap2D asStockGrid() const;
+
 	MAP_DEFINITION_START(CGroundAwareOccupancyGrid)
 	float min_x = -10.0f, max_x = 10.0f, min_y = -10.0f, max_y = 10.0f, resolution = 0.05f;
 	mrpt::maps::COccupancyGridMap2D::TInsertionOptions insertionOpts;
@@ -160,6 +196,8 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	MAP_DEFINITION_END(CGroundAwareOccupancyGrid)
 
    protected:
+	/** The base's clear (cells unknown, extent +-10 m) and the run state. */
+	void internal_clear() override;
 	bool internal_insertObservation(
 		const mrpt::obs::CObservation& obs,
 		const std::optional<const mrpt::poses::CPose3D>& robotPose = std::nullopt) override;
@@ -195,6 +233,12 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	// obstacle_decay_s: last time each positive obstacle cell was seen as one,
 	// keyed by its world cell (stable when the grid grows). Not serialized.
 	std::unordered_map<int64_t, double> m_positiveSeen;
+	// Depth frames received (scan_keeps_3d_obstacles = auto), serialized; and
+	// 2D scans received while none had come (for the one-line warning).
+	uint64_t m_depthFrames = 0;
+	uint64_t m_scansBeforeDepth = 0;
+	bool m_warnedNoFreeSpace = false;
+	void resetRunState();
 };
 
 }  // namespace mrpt::maps
