@@ -51,6 +51,12 @@ int main(int argc, char** argv)
 			"FILE.ini", cmd);
 		TCLAP::ValueArg<std::string> aSection(
 			"s", "section", "section of the .ini with the <map>_count keys", false, "map", "NAME", cmd);
+		TCLAP::ValueArg<std::string> aInitial(
+			"", "initial-map",
+			"start every 2D grid that can from a stock occupancy grid: .gridmap / .gridmap.gz (a serialized "
+			"COccupancyGridMap2D or subclass) or a ROS map_server .yaml; its extent, resolution and cells "
+			"(the .ini's options stay)",
+			false, "", "FILE", cmd);
 		TCLAP::SwitchArg aPrint("", "print-default-config", "print the embedded default .ini and exit", cmd);
 		TCLAP::SwitchArg aLocal(
 			"", "local-map", "robot-centred local maps: every 2D grid is kept as a window that follows the robot", cmd);
@@ -85,6 +91,7 @@ int main(int argc, char** argv)
 		o.localMap = aLocal.getValue();
 		o.localCells = aLocalCells.getValue();
 		o.maxFrames = size_t(aMaxFrames.getValue());
+		o.initialMap = aInitial.getValue();
 		o.snapshotEvery = size_t(aSnapshotEvery.getValue());
 		o.pngLegend = aPngLegend.getValue();
 		o.progress = !aQuiet.getValue();
@@ -115,6 +122,7 @@ int main(int argc, char** argv)
 		std::signal(SIGTERM, onSignal);
 		gam::mapper::Mapper mapper(o);
 		for (const auto& w : mapper.warnings()) std::cerr << kApp << ": warning: " << w << std::endl;
+		if (!mapper.initialMapNote().empty()) std::cout << kApp << ": " << mapper.initialMapNote() << std::endl;
 		const auto s = mapper.run();
 		std::cout << kApp << ": " << s.text() << "outputs: " << s.files.size() << " files in " << o.outDir << std::endl;
 		return 0;

@@ -741,3 +741,54 @@ TEST(MapperCli, MapsComeFromTheIniAlone)
 	}
 	EXPECT_GT(pFree(readGridmapGz(out + "/stock.gridmap.gz"), 1.02, 0.03), 0.6);
 }
+
+TEST_F(MapperE2E, InitialMapStartsEveryGridThatCanFromAStockMap)
+{
+	// Issue #31: a stock map (a wall block far behind the robot and a free
+	// patch) in both stock formats; the run's grids start from it.
+	COccupancyGridMap2D stock(-8, 4, -6, 6, 0.05f);
+	for (float x = -6.0f; x < -5.5f; x += 0.05f)
+		for (float y = 3.0f; y < 4.0f; y += 0.05f) stock.setPos(x + 0.025f, y + 0.025f, 0.05f);
+	for (float x = -4.0f; x < -3.0f; x += 0.05f)
+		for (float y = -4.0f; y < -3.0f; y += 0.05f) stock.setPos(x + 0.025f, y + 0.025f, 0.95f);
+	const std::string gz = kTmp + "/initial.gridmap.gz";
+	writeSerializedGz(stock, gz);
+	writeRosMap(stock, kTmp + "/initial.yaml", kTmp + "/initial.pgm", "initial.pgm");
+	for (const std::string& file : {gz, kTmp + "/initial.yaml"})
+	{
+		SCOPED_TRACE(file);
+		const std::string out = freshDir("out_initial");
+		const auto r = runMapper("--rawlog '" + obsRawlog + "' --out '" + out + "' --initial-map '" + file + "'");
+		ASSERT_EQ(r.rc, 0) << r.err;
+		EXPECT_NE(r.out.find("loaded into: ground_aware, height_band; not into elevation, octomap"), std::string::npos)
+			<< r.out;
+		for (const std::string n : {"ground_aware", "height_band"})
+		{
+			SCOPED_TRACE(n);
+			const auto g = readGridmapGz(out + "/" + n + ".gridmap.gz");
+			EXPECT_LE(g.getXMin(), -8.0f + 1e-3f);
+			EXPECT_GE(g.getYMax(), 6.0f - 1e-3f);
+			EXPECT_LT(pFree(g, -5.8, 3.5), 0.1) << "the stock map's wall";
+			EXPECT_GT(pFree(g, -3.5, -3.5), 0.9) << "the stock map's free patch";
+			EXPECT_NEAR(pFree(g, -7.0, 0.0), 0.5, 1e-3) << "unknown in the stock map, not seen in the run";
+		}
+		// The run still maps: the box in front of the robot, as without the initial map.
+		const auto ga = readGridmapGz(out + "/ground_aware.gridmap.gz");
+		const Box& b = kBoxObstacle;
+		EXPECT_LT(minPFree(ga, b.x0 - 0.05, b.x0 + 0.1, b.y0 + 0.05, b.y1 - 0.05), 0.3);
+		const auto oc = readGridmapGz(out + "/octomap.gridmap.gz");
+		EXPECT_NEAR(pFree(oc, -5.8, 3.5), 0.5, 1e-3) << "the octomap's projection does not start from a grid";
+	}
+	// Bad files: one-line errors naming the file.
+	const std::string out = freshDir("out_initial_bad");
+	expectError(
+		runMapper("--rawlog '" + obsRawlog + "' --out '" + out + "' --initial-map /nonexistent/m.gridmap"), 2,
+		{"--initial-map", "cannot open /nonexistent/m.gridmap"}, out);
+	expectError(
+		runMapper("--rawlog '" + obsRawlog + "' --out '" + out + "' --initial-map '" + obsRawlog + "'"), 2,
+		{"--initial-map", "not an occupancy grid"}, out);
+	std::ofstream(kTmp + "/bad.yaml") << "image: missing.pgm\n";
+	expectError(
+		runMapper("--rawlog '" + obsRawlog + "' --out '" + out + "' --initial-map '" + kTmp + "/bad.yaml'"), 2,
+		{"--initial-map", "bad.yaml", "not a ROS map_server map"}, out);
+}

@@ -29,6 +29,7 @@ const bool kTraitsRegistered = [] {
 		{"_bandOpts", gam::maps::ini::keys<CHeightBandOccupancyGrid::THeightBandOptions>()}};
 	t.writeOutputs = gam::maps::writeGridOutputs;
 	t.keepWindow = gam::maps::keepGridWindow;
+	t.startFromGrid = gam::maps::startGridFromStock;
 	gam::maps::registerMapTraits(std::move(t));
 	return true;
 }();

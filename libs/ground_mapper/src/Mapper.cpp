@@ -2,6 +2,7 @@
 #include <gam/mapper/Errors.h>
 #include <gam/mapper/Mapper.h>
 #include <gam/mapper/RawlogFrames.h>
+#include <gam/maps/GridIO.h>
 #include <gam/maps/MapRegistry.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/core/bits_math.h>
@@ -137,6 +138,37 @@ Mapper::Mapper(const MapperOptions& opts) : m_opts(opts)
 	for (size_t i = 0; i < m_specs.size(); i++)
 		if (m_maps.maps[i]->GetRuntimeClass()->className != m_specs[i].className)
 			throw ConfigError("internal: CMultiMetricMap map order differs from the .ini order");
+	if (!m_opts.initialMap.empty()) loadInitialMap();
+}
+
+void Mapper::loadInitialMap()
+{
+	mrpt::maps::COccupancyGridMap2D stock;
+	try
+	{
+		stock = gam::maps::readStockGrid(m_opts.initialMap);
+	}
+	catch (const std::exception& e)
+	{
+		throw ConfigError("--initial-map: " + conciseError(e.what()));
+	}
+	std::string into, notInto;
+	for (size_t i = 0; i < m_specs.size(); i++)
+	{
+		const gam::maps::MapTraits* t = gam::maps::findMapTraits(*m_maps.maps[i]);
+		std::string& list = t && t->startFromGrid ? into : notInto;
+		list += (list.empty() ? "" : ", ") + m_specs[i].label;
+		if (t && t->startFromGrid) t->startFromGrid(*m_maps.maps[i], stock);
+	}
+	if (into.empty())
+		throw ConfigError(
+			"--initial-map " + m_opts.initialMap + ": no map of the .ini can start from a 2D grid (" + notInto + ")");
+	char b[160];
+	std::snprintf(
+		b, sizeof b, "%u x %u cells at %.3f m, x [%.2f, %.2f] y [%.2f, %.2f]", stock.getSizeX(), stock.getSizeY(),
+		stock.getResolution(), stock.getXMin(), stock.getXMax(), stock.getYMin(), stock.getYMax());
+	m_initialMapNote = "initial map " + m_opts.initialMap + " (" + b + ") loaded into: " + into;
+	if (!notInto.empty()) m_initialMapNote += "; not into " + notInto + " (cannot start from a grid)";
 }
 
 namespace

@@ -58,6 +58,9 @@ const bool kTraitsRegistered = [] {
 	};
 	// The missing-floor layer follows the grid's window: missingFloorLayer() re-syncs it.
 	t.keepWindow = gam::maps::keepGridWindow;
+	t.startFromGrid = [](CMetricMap& m, const COccupancyGridMap2D& stock) {
+		dynamic_cast<CGroundAwareOccupancyGrid&>(m).loadFromStockGrid(stock);
+	};
 	t.stageTimes = [](const CMetricMap& m, bool depthFrame, const gam::maps::StageSink& sink) {
 		const auto& g = dynamic_cast<const CGroundAwareOccupancyGrid&>(m);
 		if (!depthFrame || !g.lastFrame().valid) return;
@@ -231,11 +234,7 @@ bool CGroundAwareOccupancyGrid::scanRuleActive() const
 
 void CGroundAwareOccupancyGrid::loadFromStockGrid(const COccupancyGridMap2D& stock)
 {
-	setSize(stock.getXMin(), stock.getXMax(), stock.getYMin(), stock.getYMax(), stock.getResolution(), 0.5f);
-	// setSize rounds the cell count the way the stock grid's own setSize did,
-	// so the two have the same size; copy row by row all the same.
-	const unsigned w = std::min(getSizeX(), stock.getSizeX()), h = std::min(getSizeY(), stock.getSizeY());
-	for (unsigned cy = 0; cy < h; cy++) std::copy_n(stock.getRow(int(cy)), w, getRow(int(cy)));
+	gam::maps::copyGridCells(stock, *this);
 	// (A deserialized stock grid reports isEmpty() whatever its cells hold:
 	// the flag is not serialized. A cell that is not unknown decides.)
 	m_is_empty = stock.isEmpty() && std::all_of(m_map.begin(), m_map.end(), [](cellType c) { return c == 0; });

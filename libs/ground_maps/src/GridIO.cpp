@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 
@@ -54,6 +55,15 @@ void writeRosMap(
 	  << "free_thresh: 0.196\n";
 	y.flush();
 	if (!y) throw std::runtime_error("cannot write " + yamlPath);
+}
+
+void copyGridCells(const COccupancyGridMap2D& from, COccupancyGridMap2D& to)
+{
+	to.setSize(from.getXMin(), from.getXMax(), from.getYMin(), from.getYMax(), from.getResolution(), 0.5f);
+	// setSize rounds the cell count as the source's own setSize did, so the
+	// sizes agree; copy row by row within both all the same.
+	const unsigned w = std::min(to.getSizeX(), from.getSizeX()), h = std::min(to.getSizeY(), from.getSizeY());
+	for (unsigned cy = 0; cy < h; cy++) std::copy_n(from.getRow(int(cy)), w, to.getRow(int(cy)));
 }
 
 COccupancyGridMap2D plainCopy(const COccupancyGridMap2D& g) { return COccupancyGridMap2D(g); }
@@ -197,16 +207,34 @@ COccupancyGridMap2D readStockGrid(const std::string& path)
 				   return std::tolower(static_cast<unsigned char>(a)) == b;
 			   });
 	};
+	if (!std::ifstream(path)) throw std::runtime_error("cannot open " + path);
 	COccupancyGridMap2D g;
 	if (endsWith(".yaml") || endsWith(".yml"))
 	{
-		if (!std::ifstream(path)) throw std::runtime_error("cannot open " + path);
-		// MRPT prints the reason on stderr and returns false.
-		if (!g.loadFromROSMapServerYAML(path))
+		// MRPT prints the reason (with a call stack) on std::cerr and returns
+		// false: keep its "Message:" line for our one-line error.
+		std::ostringstream mrptSays;
+		std::streambuf* const cerrBuf = std::cerr.rdbuf(mrptSays.rdbuf());
+		bool ok = false;
+		try
+		{
+			ok = g.loadFromROSMapServerYAML(path);
+		}
+		catch (...)
+		{
+		}
+		std::cerr.rdbuf(cerrBuf);
+		if (!ok)
+		{
+			std::string why = mrptSays.str();
+			const auto m = why.find("Message:");
+			why = m == std::string::npos ? "" : why.substr(m + 8, why.find('\n', m) - m - 8);
 			throw std::runtime_error(
 				path +
 				": not a ROS map_server map (needs image, resolution, origin, occupied_thresh, free_thresh, "
-				"negate; see the message above)");
+				"negate)" +
+				(why.empty() ? "" : ":" + why));
+		}
 		return g;
 	}
 	mrpt::io::CFileGZInputStream f;

@@ -28,6 +28,7 @@ const bool kGridTraits = [] {
 	t.className = "mrpt::maps::COccupancyGridMap2D";
 	t.writeOutputs = writeGridOutputs;
 	t.keepWindow = keepGridWindow;
+	t.startFromGrid = startGridFromStock;
 	registerMapTraits(std::move(t));
 	return true;
 }();
@@ -64,6 +65,11 @@ std::vector<std::string> gridCreationKeys()
 	for (const char* g : {"label", "enableSaveAs3DObject", "enableObservationLikelihood", "enableObservationInsertion"})
 		k.push_back(g);
 	return k;
+}
+
+void startGridFromStock(mrpt::maps::CMetricMap& map, const mrpt::maps::COccupancyGridMap2D& stock)
+{
+	copyGridCells(stock, dynamic_cast<mrpt::maps::COccupancyGridMap2D&>(map));
 }
 
 void keepGridWindow(mrpt::maps::CMetricMap& map, double x, double y, int cells)

@@ -37,6 +37,11 @@ struct MapperOptions
 	bool localMap = false;
 	int localCells = 600;
 	size_t maxFrames = 0;  ///< 0 = all
+	/** If set: a stock occupancy grid (`.gridmap`, `.gridmap.gz` or a ROS
+	 * map_server `.yaml`; gam::maps::readStockGrid) that every 2D grid of the
+	 * .ini starts from (its extent, resolution and cells; the .ini's options
+	 * stay). A ground-aware grid takes it with loadFromStockGrid(). */
+	std::string initialMap;
 	/** > 0: after every N-th frame, the map_server maps (`<label>.yaml` + `.pgm`)
 	 * of every 2D grid as they are after that frame, in
 	 * `outDir/snapshots/NNNNNN/` (NNNNNN = frames inserted so far), plus
@@ -119,6 +124,8 @@ class Mapper
 	const std::vector<MapSpec>& specs() const { return m_specs; }
 	/** Configuration warnings (printed by the app before running). */
 	const std::vector<std::string>& warnings() const { return m_warnings; }
+	/** What --initial-map loaded, and into which grids ("" without it). */
+	const std::string& initialMapNote() const { return m_initialMapNote; }
 
    private:
 	void writeMaps(const std::string& tmpDir, RunSummary& s);
@@ -128,6 +135,8 @@ class Mapper
 	mrpt::maps::CMultiMetricMap m_maps;
 	std::vector<MapSpec> m_specs;
 	std::vector<std::string> m_warnings;
+	std::string m_initialMapNote;
+	void loadInitialMap();
 	mrpt::poses::CPose3D m_lastPose;
 	/** [sensor_poses] of the .ini: sensorPose per sensor label, replacing the
 	 * rawlog's (gam-calibrate --write-ini writes it). */

@@ -57,6 +57,9 @@ void writeGridPng(const mrpt::maps::COccupancyGridMap2D& grid, const std::string
 constexpr uint8_t kUnknownR = 190, kUnknownG = 205, kUnknownB = 235;
 constexpr uint8_t kMissingR = 255, kMissingG = 140, kMissingB = 0;
 
+/** `to` takes the extent, resolution and cells of `from`; its options stay. */
+void copyGridCells(const mrpt::maps::COccupancyGridMap2D& from, mrpt::maps::COccupancyGridMap2D& to);
+
 /** A plain copy (slices a derived grid). */
 mrpt::maps::COccupancyGridMap2D plainCopy(const mrpt::maps::COccupancyGridMap2D& grid);
 

@@ -15,6 +15,11 @@
 #include <string>
 #include <vector>
 
+namespace mrpt::maps
+{
+class COccupancyGridMap2D;
+}
+
 namespace gam::maps
 {
 /** A sub-section `<prefix><suffix>` of a map and the keys it accepts (empty =
@@ -71,6 +76,10 @@ struct MapTraits
 	std::function<std::string(const mrpt::maps::CMetricMap& map)> runNote;
 	/** Local-map mode: keep only an n x n cell window centred on (x, y). */
 	std::function<void(mrpt::maps::CMetricMap& map, double x, double y, int cells)> keepWindow;
+	/** `--initial-map`: the map starts from a stock occupancy grid (its extent,
+	 * resolution and cells). Unset: the class cannot start from a grid (e.g.
+	 * a projection of a 3D map, which the next frame would redraw). */
+	std::function<void(mrpt::maps::CMetricMap& map, const mrpt::maps::COccupancyGridMap2D& stock)> startFromGrid;
 };
 
 /** Adds (or replaces) the traits of t.className. Called when a map library loads. */
@@ -91,6 +100,9 @@ std::vector<std::string> gridCreationKeys();
  * `<label>.yaml` + `.pgm`, `<label>.gridmap.gz` (stock MRPT) and `<label>.png`;
  * in local-map mode cropped to the window first. */
 void writeGridOutputs(mrpt::maps::CMetricMap& map, const OutputContext& ctx, std::vector<std::string>& files);
+
+/** startFromGrid of a COccupancyGridMap2D: copyGridCells (GridIO.h). */
+void startGridFromStock(mrpt::maps::CMetricMap& map, const mrpt::maps::COccupancyGridMap2D& stock);
 
 /** keepWindow of a COccupancyGridMap2D (see GridIO.h recentreGrid). */
 void keepGridWindow(mrpt::maps::CMetricMap& map, double x, double y, int cells);
