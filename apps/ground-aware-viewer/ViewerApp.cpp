@@ -42,7 +42,7 @@ namespace
 {
 struct Args
 {
-	std::string rawlog, config, section = "map", shotDir;
+	std::string rawlog, config, section = "map", shotDir, initialMap;
 	int frame = -1;  ///< -1 = the last one
 	bool exit = false;
 	int width = 800, height = 600;
@@ -67,6 +67,7 @@ int runBatch(const Args& a)
 {
 	ViewerModel m;
 	m.loadConfig(a.config, a.section);
+	if (!a.initialMap.empty()) m.loadInitialMap(a.initialMap);
 	m.openRawlog(a.rawlog);
 	m.seek(a.frame < 0 ? int(m.stepCount()) - 1 : std::min(a.frame, int(m.stepCount()) - 1));
 	std::cout << m.statusText();
@@ -114,6 +115,8 @@ enum
 {
 	ID_OPEN = wxID_HIGHEST + 1,
 	ID_OPEN_INI,
+	ID_OPEN_MAP,
+	ID_SAVE_MAP,
 	ID_FIRST,
 	ID_PREV,
 	ID_NEXT,
@@ -142,6 +145,8 @@ class ViewerFrame : public wxFrame
 		};
 		btn(ID_OPEN, "Open rawlog...");
 		btn(ID_OPEN_INI, "Open .ini...");
+		btn(ID_OPEN_MAP, "Start from map...");
+		btn(ID_SAVE_MAP, "Save as stock map...");
 		btn(ID_FIRST, "|<");
 		btn(ID_PREV, "<");
 		m_play = btn(ID_PLAY, "Play");
@@ -200,6 +205,10 @@ class ViewerFrame : public wxFrame
 		Bind(
 			wxEVT_BUTTON, [this](wxCommandEvent&) { onOpenIni(); }, ID_OPEN_INI);
 		Bind(
+			wxEVT_BUTTON, [this](wxCommandEvent&) { onOpenMap(); }, ID_OPEN_MAP);
+		Bind(
+			wxEVT_BUTTON, [this](wxCommandEvent&) { onSaveMap(); }, ID_SAVE_MAP);
+		Bind(
 			wxEVT_BUTTON, [this](wxCommandEvent&) { go(0); }, ID_FIRST);
 		Bind(
 			wxEVT_BUTTON, [this](wxCommandEvent&) { go(m_model.current() - 1); }, ID_PREV);
@@ -225,6 +234,7 @@ class ViewerFrame : public wxFrame
 		try
 		{
 			m_model.loadConfig(a.config, a.section);
+			if (!a.initialMap.empty()) m_model.loadInitialMap(a.initialMap);
 			if (!a.rawlog.empty())
 			{
 				m_model.openRawlog(a.rawlog);
@@ -414,6 +424,41 @@ class ViewerFrame : public wxFrame
 		refreshAll(true);
 	}
 
+	void onOpenMap()
+	{
+		wxFileDialog dlg(
+			this, "Start the grids from a stock map", "", "",
+			"Occupancy grids (*.gridmap;*.gridmap.gz;*.yaml)|*.gridmap;*.gridmap.gz;*.yaml|All files|*",
+			wxFD_OPEN | wxFD_FILE_MUST_EXIST);
+		if (dlg.ShowModal() != wxID_OK) return;
+		try
+		{
+			wxBusyCursor busy;
+			m_model.loadInitialMap(dlg.GetPath().ToStdString());
+		}
+		catch (const std::exception& e)
+		{
+			wxMessageBox(e.what(), "cannot read the map", wxICON_ERROR);
+		}
+		refreshAll(true);
+	}
+
+	void onSaveMap()
+	{
+		wxFileDialog dlg(
+			this, "Save the ground-aware grid as a stock COccupancyGridMap2D", "", "ground_aware.gridmap.gz",
+			"MRPT grid (*.gridmap.gz)|*.gridmap.gz|ROS map_server (*.yaml)|*.yaml", wxFD_SAVE | wxFD_OVERWRITE_PROMPT);
+		if (dlg.ShowModal() != wxID_OK) return;
+		try
+		{
+			m_model.saveGroundAwareAsStockGrid(dlg.GetPath().ToStdString());
+		}
+		catch (const std::exception& e)
+		{
+			wxMessageBox(e.what(), "cannot save the map", wxICON_ERROR);
+		}
+	}
+
 	void onExport()
 	{
 		wxDirDialog dlg(this, "Export a PNG of each view into", m_args.shotDir);
@@ -483,6 +528,10 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<std::string> argShots(
 			"", "screenshot-dir", "write DIR/<view>.png of every view (with --exit: batch mode, no display)", false, "",
 			"DIR", cmd);
+		TCLAP::ValueArg<std::string> argInitial(
+			"", "initial-map",
+			"the ground-aware and height-band grids start from a stock map (.gridmap, .gridmap.gz or ROS .yaml)", false,
+			"", "FILE", cmd);
 		TCLAP::SwitchArg argExit("", "exit", "batch mode: render the screenshots and exit", cmd);
 		TCLAP::ValueArg<int> argW("", "width", "screenshot width [px]", false, 800, "W", cmd);
 		TCLAP::ValueArg<int> argH("", "height", "screenshot height [px]", false, 600, "H", cmd);
@@ -496,6 +545,7 @@ int main(int argc, char** argv)
 		a.section = argSection.getValue();
 		a.frame = argFrame.getValue();
 		a.shotDir = argShots.getValue();
+		a.initialMap = argInitial.getValue();
 		a.exit = argExit.getValue();
 		a.width = argW.getValue();
 		a.height = argH.getValue();

@@ -1,6 +1,7 @@
 // Ground-aware mapping for MRPT -- ground-aware-viewer, the GUI-free part.
 #include "ViewerModel.h"
 
+#include <gam/maps/GridIO.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/maps/CMultiMetricMap.h>
@@ -90,9 +91,48 @@ void ViewerModel::loadConfig(const std::string& iniPath, const std::string& sect
 	m_gaTemplate = create<CGroundAwareOccupancyGrid>(*defGA);
 	m_hbTemplate = create<CHeightBandOccupancyGrid>(*defHB);
 	m_ocTemplate = create<COctoMapGrid2D>(*defOC);
+	m_configPath = iniPath;  // (a later loadInitialMap re-reads it)
+	m_configSection = section;
+	applyInitialMap();
 	const int cur = m_current;
 	resetMaps();
 	if (cur >= 0) seek(cur);
+}
+
+void ViewerModel::applyInitialMap()
+{
+	if (!m_initialMap) return;
+	// The octomap's grid is a projection of its octree, redrawn every frame:
+	// it cannot start from a grid.
+	m_gaTemplate->loadFromStockGrid(*m_initialMap);
+	gam::maps::copyGridCells(*m_initialMap, *m_hbTemplate);
+}
+
+void ViewerModel::loadInitialMap(const std::string& path)
+{
+	if (path.empty())
+	{
+		m_initialMap.reset();
+		m_initialMapPath.clear();
+		loadConfig(m_configPath, m_configSection);
+		return;
+	}
+	m_initialMap = std::make_shared<mrpt::maps::COccupancyGridMap2D>(gam::maps::readStockGrid(path));
+	m_initialMapPath = path;
+	loadConfig(m_configPath, m_configSection);
+}
+
+void ViewerModel::saveGroundAwareAsStockGrid(const std::string& path) const
+{
+	const mrpt::maps::COccupancyGridMap2D stock = m_ga->asStockGrid();
+	const bool yaml = path.size() > 5 && (path.substr(path.size() - 5) == ".yaml");
+	if (yaml)
+	{
+		const std::string pgm = path.substr(0, path.size() - 5) + ".pgm";
+		gam::maps::writeRosMap(stock, path, pgm, std::filesystem::path(pgm).filename().string());
+	}
+	else
+		gam::maps::writeSerializedGz(stock, path);
 }
 
 void ViewerModel::resetMaps()

@@ -55,6 +55,17 @@ class ViewerModel
 	 * elevation map then covers +-10 m). Empty path = class defaults. Throws on a bad .ini.
 	 * Resets the maps (re-runs up to the current step). */
 	void loadConfig(const std::string& iniPath, const std::string& section = "map");
+	/** The ground-aware and height-band grids start from a stock occupancy
+	 * grid (`.gridmap[.gz]` or ROS map_server `.yaml`, gam::maps::readStockGrid),
+	 * also after a later loadConfig(); "" = from nothing again. Throws
+	 * std::runtime_error on a bad file (the maps are then unchanged). Re-runs up
+	 * to the current step. */
+	void loadInitialMap(const std::string& path);
+	const std::string& initialMapPath() const { return m_initialMapPath; }
+	/** Writes the ground-aware grid as a stock COccupancyGridMap2D, which any
+	 * MRPT tool reads: `.yaml` = ROS map_server pair (+ `.pgm` beside it),
+	 * anything else = a gzip-serialized `.gridmap`. Throws std::runtime_error. */
+	void saveGroundAwareAsStockGrid(const std::string& path) const;
 
 	size_t stepCount() const { return m_steps.size(); }
 	const Step& step(size_t i) const { return m_steps.at(i); }
@@ -98,10 +109,13 @@ class ViewerModel
 
    private:
 	void resetMaps();
+	void applyInitialMap();
 	void insertStep(size_t k);
 	void updatePoints();
 
 	std::string m_rawlog;
+	std::string m_initialMapPath, m_configPath, m_configSection = "map";
+	std::shared_ptr<mrpt::maps::COccupancyGridMap2D> m_initialMap;
 	std::vector<Step> m_steps;
 	int m_current = -1;
 	std::shared_ptr<mrpt::maps::CGroundAwareOccupancyGrid> m_ga, m_gaTemplate, m_gaBefore;

@@ -12,6 +12,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <gam/maps/GridIO.h>
+
 #include "ViewerScene.h"
 
 namespace fs = std::filesystem;
@@ -263,4 +265,39 @@ TEST_F(Viewer, GuiStartsEditsAParameterAndDrawsUnderXvfb)
 	ASSERT_TRUE(img.loadFromFile(png));
 	EXPECT_GT(img.getWidth(), 800u);
 	EXPECT_GT(imageStats(img).variance, 200.0);
+}
+
+TEST_F(Viewer, StartsFromAStockMapAndSavesAsOne)
+{
+	// Issue #31: a stock map (a wall block behind the robot) in, the
+	// ground-aware grid out as a plain COccupancyGridMap2D.
+	mrpt::maps::COccupancyGridMap2D stock(-6, 6, -4, 4, 0.05f);
+	for (float x = -3.0f; x < -2.5f; x += 0.05f)
+		for (float y = 1.0f; y < 1.5f; y += 0.05f) stock.setPos(x + 0.025f, y + 0.025f, 0.05f);
+	const std::string in = kTmp + "/stock.gridmap.gz";
+	gam::maps::writeSerializedGz(stock, in);
+
+	ViewerModel m;
+	m.loadInitialMap(in);
+	EXPECT_EQ(m.initialMapPath(), in);
+	EXPECT_LT(m.groundAware().getPos(-2.8f, 1.2f), 0.1f);
+	EXPECT_LT(m.heightBand().getPos(-2.8f, 1.2f), 0.1f);
+	m.openRawlog(rawlog);
+	m.seek(10);
+	EXPECT_LT(m.groundAware().getPos(-2.8f, 1.2f), 0.1f) << "kept: nothing in the run sees it";
+	EXPECT_LT(m.groundAware().getPos(2.5f, 0.0f), 0.3f) << "the hatch, mapped on top";
+	m.loadConfig("");  // a new .ini keeps the initial map
+	EXPECT_LT(m.groundAware().getPos(-2.8f, 1.2f), 0.1f);
+	EXPECT_THROW(m.loadInitialMap(kTmp + "/missing.gridmap"), std::runtime_error);
+	EXPECT_EQ(m.initialMapPath(), in) << "a bad file changes nothing";
+
+	const std::string out = kTmp + "/saved.gridmap.gz";
+	m.saveGroundAwareAsStockGrid(out);
+	const auto back = gam::maps::readGridmapGz(out);  // as a stock tool reads it: `>> COccupancyGridMap2D`
+	EXPECT_EQ(back.getRawMap(), m.groundAware().getRawMap());
+	m.saveGroundAwareAsStockGrid(kTmp + "/saved.yaml");
+	EXPECT_TRUE(fs::exists(kTmp + "/saved.pgm"));
+	EXPECT_EQ(gam::maps::readStockGrid(kTmp + "/saved.yaml").getSizeX(), m.groundAware().getSizeX());
+	m.loadInitialMap("");
+	EXPECT_NEAR(m.groundAware().getPos(-2.8f, 1.2f), 0.5f, 1e-3f) << "from nothing again";
 }
