@@ -423,3 +423,47 @@ TEST(ElevationGridIdw, LargerRadiusAndObservationReplacesEstimate)
 		EXPECT_TRUE(std::isnan(c.z_idw));
 	}
 }
+
+TEST(ElevationCellTest, VarianceKeepsItsPrecisionTenMetresUp)
+{
+	// Issue #30: an upper storey in a global map, z = 10 m, 3 mm floor noise.
+	// Samples 10 + a, 10 - a (3 of each, a = 0.003): mean 10, every deviation
+	// a, so the variance is 6 a^2 / 6 = a^2 = 9e-6 m^2 (std 3 mm). In float,
+	// E[z^2] - E[z]^2 = 100.000009 - 100 is below the 7.6e-6 spacing of floats
+	// near 100: it came out 7.6e-6 here, and 0 for the cells below.
+	const float a = 0.003f;
+	ElevationCell c;
+	for (int k = 0; k < 3; k++)
+	{
+		c.add(10.0f + a);
+		c.add(10.0f - a);
+	}
+	EXPECT_NEAR(c.mean(), 10.0, 1e-5);
+	EXPECT_NEAR(c.variance(), 9e-6, 1e-8);
+
+	// The same samples in two cells merged (Chan): cell A {10+a, 10+a, 10-a},
+	// cell B {10-a, 10-a, 10+a}: means 10 + a/3 and 10 - a/3, each with
+	// squared deviations 2 (2a/3)^2 + (4a/3)^2 = 24 a^2 / 9 (variance 8 a^2 / 9);
+	// merged: 2 x 24 a^2 / 9 + (2a/3)^2 x 3 x 3 / 6 = 48 a^2 / 9 + 6 a^2 / 9 =
+	// 6 a^2, over 6 samples: a^2.
+	ElevationCell A, B;
+	for (float z : {10.0f + a, 10.0f + a, 10.0f - a}) A.add(z);
+	for (float z : {10.0f - a, 10.0f - a, 10.0f + a}) B.add(z);
+	EXPECT_NEAR(A.variance(), 24.0 * 9e-6 / 9.0 / 3.0, 1e-8);
+	A.merge(B);
+	EXPECT_EQ(A.count, 6u);
+	EXPECT_NEAR(A.variance(), 9e-6, 1e-8);
+
+	// And through the grid's insertion (the 3-sigma filter's shifted sums).
+	ElevationGrid grid(gamtest::makeGeometry(0, 0, 0.05, 4, 4));
+	BinnedPoints b;
+	for (int k = 0; k < 3; k++)
+	{
+		grid.binPoint(0.07, 0.07, 10.0f + a, b);
+		grid.binPoint(0.07, 0.07, 10.0f - a, b);
+	}
+	OutlierFilterParams f;
+	f.min_count = 4;  // the 3-sigma rule runs on this cell
+	EXPECT_EQ(grid.insert(b, f), 6u);
+	EXPECT_NEAR(grid.cell(1, 1).variance(), 9e-6, 1e-8);
+}

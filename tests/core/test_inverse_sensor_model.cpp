@@ -1039,3 +1039,30 @@ TEST(InverseSensorModel, FloorNoiseIsMeasuredPerRangeBin)
 	p.floor_noise_bin = 0;  // below its range 0.05 .. 10 m
 	EXPECT_THROW(InverseSensorModel{p}, std::invalid_argument);
 }
+
+TEST(InverseSensorModel, FloorNoiseIsMeasuredOnAnUpperStoreyToo)
+{
+	// Issue #30: the same measurement as above on a floor at z = 10 m (a map
+	// in a building's frame), sensor 1 m above it at (0, 0, 11). Cells of the
+	// strip x in [0.5, 0.9), |y| <= 0.1 (3D range 1.118 .. 1.35 m, one bin of
+	// [1.0, 1.5)) hold 10 + a, 10 - a, 10 + a, 10 - a with a = 3 mm: sample std
+	// a, so the band is d_pth + noise_sigmas * a = 0.03 + 3 * 0.003 = 0.039 m.
+	// With the variance as float E[z^2] - E[z]^2 the std came out between 0 and
+	// ~5 mm (100.000009 - 100 is below float resolution near 100).
+	ElevationGrid frame(gamtest::makeGeometry(-1, -1, 0.05, 60, 40));
+	const GridGeometry& g = frame.geometry();
+	BinnedPoints pts;
+	const float a = 0.003f;
+	size_t cells = 0;
+	for (int iy = g.iy(-0.1 + 1e-6); iy < g.iy(0.1 - 1e-6) + 1; iy++)
+		for (int ix = g.ix(0.5 + 1e-6); ix < g.ix(0.9 - 1e-6) + 1; ix++, cells++)
+			for (float z : {10.0f + a, 10.0f - a, 10.0f + a, 10.0f - a}) pts.push(uint32_t(g.index(ix, iy)), z);
+	ASSERT_GE(cells, 10u);  // floor_noise_min_cells
+	frame.insert(pts, OutlierFilterParams{});
+	const Eigen::Vector3d sensor(0, 0, 11);
+	const Plane upperFloor{0, 0, 1, -10};  // z = 10
+	IsmStats st;
+	InverseSensorModel ism;
+	ism.compute(frame, handDetection(upperFloor), sensor, 5.0, st);
+	EXPECT_NEAR(ism.groundBand(sensor, 1.0, std::sqrt(1.25 * 1.25 - 1), 0, 10), 0.039, 1e-5);
+}

@@ -76,7 +76,9 @@ ElevationCell toCell(const ElevationGrid::FrameCell& a)
 	c.z_max = a.z_max;
 	const double n = a.count, ref = a.ref, s1 = a.s1, s2 = a.s2;
 	c.z_sum = float(n * ref + s1);
-	c.z_sq_sum = float(n * ref * ref + 2 * ref * s1 + s2);
+	// Deviations from the mean, from those from the first sample: no large
+	// number is ever formed (they were turned back into sums of z^2 here).
+	c.z_m2 = float(std::max(0.0, s2 - s1 * s1 / n));
 	return c;
 }
 }  // namespace

@@ -189,7 +189,9 @@ std::string CElevation25DMap::asString() const
 
 // ---------------------------------------------------------------------------
 // Serialization: v0 = geometry, insertion options, generic params, observed cells.
-uint8_t CElevation25DMap::serializeGetVersion() const { return 0; }
+// v0: cells with the sum of z^2; v1: with the sum of squared deviations from
+// the mean (ElevationCell::z_m2).
+uint8_t CElevation25DMap::serializeGetVersion() const { return 1; }
 
 void CElevation25DMap::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -204,7 +206,7 @@ void CElevation25DMap::serializeTo(mrpt::serialization::CArchive& out) const
 	for (uint32_t i : m_grid.observedCells())
 	{
 		const auto& c = m_grid.cell(i);
-		out << i << c.z_min << c.z_max << c.count << c.z_sum << c.z_sq_sum;
+		out << i << c.z_min << c.z_max << c.count << c.z_sum << c.z_m2;
 	}
 }
 
@@ -212,7 +214,8 @@ void CElevation25DMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t 
 {
 	switch (version)
 	{
-		case 0: {
+		case 0:
+		case 1: {
 			gam::GridGeometry g;
 			int32_t nx, ny;
 			in >> g.x_min >> g.y_min >> g.resolution >> nx >> ny;
@@ -238,9 +241,11 @@ void CElevation25DMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t 
 			{
 				uint32_t i;
 				gam::ElevationCell c;
-				in >> i >> c.z_min >> c.z_max >> c.count >> c.z_sum >> c.z_sq_sum;
+				in >> i >> c.z_min >> c.z_max >> c.count >> c.z_sum >> c.z_m2;
 				if (i >= g.cellCount() || c.count == 0)
 					throw std::runtime_error("CElevation25DMap: corrupt stream (bad cell)");
+				if (version == 0)  // the sum of z^2: as precise as it was written
+					c.z_m2 = float(std::max(0.0, double(c.z_m2) - double(c.z_sum) * double(c.z_sum) / double(c.count)));
 				m_grid.restoreCell(i, c);
 			}
 			if (o.idw.radius_cells > 0) m_grid.interpolateIdw(o.idw);
