@@ -10,7 +10,6 @@
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CMultiMetricMap.h>
 
-#include <chrono>
 #include <fstream>
 #include <sstream>
 
@@ -46,14 +45,6 @@ std::string oneMap(const std::string& kind, const std::string& sub, const std::s
 	return "[map]\n" + kind + "_count=1\n[map_" + kind + "_00_" + sub + "]\n" + body;
 }
 
-long rssKiB()
-{
-	std::ifstream f("/proc/self/status");
-	std::string l;
-	while (std::getline(f, l))
-		if (l.rfind("VmRSS:", 0) == 0) return std::stol(l.substr(6));
-	return -1;
-}
 }  // namespace
 
 TEST(RobustConfig, EveryMapKindRejectsBadExtentsAndResolution)
@@ -78,16 +69,14 @@ TEST(RobustConfig, EveryMapKindRejectsBadExtentsAndResolution)
 
 TEST(RobustConfig, MapsTooLargeForMemoryAreRefusedBeforeAllocating)
 {
-	// 200 km x 200 km at 1 mm: 4e16 cells. Each must fail fast with a clear error.
-	const long rss0 = rssKiB();
+	// 200 km x 200 km at 1 mm: 4e16 cells. Each must fail with a clear error
+	// before allocating (an allocation that size could only end in
+	// std::bad_alloc, not in this message). How fast: tests/bench, not here.
 	for (const auto& kind : kKinds)
 	{
-		const auto t0 = std::chrono::steady_clock::now();
 		const std::string err = buildError(oneMap(
 			kind, "creationOpts", "min_x=-100000\nmax_x=100000\nmin_y=-100000\nmax_y=100000\nresolution=0.001\n"));
-		const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 		EXPECT_NE(err.find("too large"), std::string::npos) << kind << ": " << err;
-		EXPECT_LT(s, 2.0) << kind;
 	}
 	{
 		// The ground-aware grid's per-frame 2.5D map: m_x x m_y, checked at load time.
@@ -95,8 +84,6 @@ TEST(RobustConfig, MapsTooLargeForMemoryAreRefusedBeforeAllocating)
 		EXPECT_NE(err.find("too large"), std::string::npos) << err;
 		EXPECT_NE(err.find("m_x"), std::string::npos) << err;
 	}
-	// Nothing big was allocated on the way.
-	EXPECT_LT(rssKiB() - rss0, 100 * 1024) << "KiB";
 	// Just over the limits: 2D grids 2^28 cells, the elevation map 2^26.
 	for (const auto& kind : {"groundAwareGrid", "heightBandGrid", "octoMapGrid"})
 	{
@@ -152,27 +139,62 @@ TEST(RobustConfig, ThresholdsOutOfRangeForTheComparisonAndElevationMaps)
 	}
 }
 
-TEST(RobustConfig, GarbageIniTextGivesAnErrorNotACrash)
+TEST(RobustConfig, GarbageIniTextGivesAnErrorOrTheDefaults)
 {
-	const std::vector<std::string> texts = {
-		"",
-		"[map]\n",
-		"[map]\ngroundAwareGrid_count=-1\n",
-		"[map]\ngroundAwareGrid_count=1e9\n",
-		"[map]\ngroundAwareGrid_count=\n",
-		"[map\ngroundAwareGrid_count=1\n",
-		"[map]\ngroundAwareGrid_count=1\n[map_groundAwareGrid_00_groundOpts]\n=\n==\nK\n",
-		[] {
-			static const char raw[] = "[map]\ngroundAwareGrid_count=1\n\0\xff\xfe[x]\n";
-			return std::string(raw, sizeof(raw) - 1);  // with the NUL byte inside
-		}(),
-		"[map]\nCElevation25DMap_count=1\n[map_CElevation25DMap_00_creationOpts]\nlabel=../../etc/passwd\n"};
-	for (const auto& t : texts)
+	// Each text with its right outcome: an error containing `error`, or (error
+	// "") accepted with `maps` maps, the ground-aware one with Table I's K.
+	struct Case
 	{
-		const std::string err = buildError(t);
-		if (t.find("_count=1\n") == std::string::npos || t.find("label") != std::string::npos)
+		std::string text, error;
+		size_t maps;
+	};
+	const std::vector<Case> cases = {
+		{"", "no [map] section", 0},
+		{"[map]\n", "no maps defined in [map]", 0},
+		{"[map]\ngroundAwareGrid_count=-1\n", "groundAwareGrid_count", 0},
+		{"[map]\ngroundAwareGrid_count=1e9\n", "groundAwareGrid_count", 0},
+		{"[map]\ngroundAwareGrid_count=\n", "groundAwareGrid_count", 0},
+		// A broken section header: the [map] section does not exist.
+		{"[map\ngroundAwareGrid_count=1\n", "no [map] section", 0},
+		// Lines with no key name and a key without '=': MRPT's .ini parser
+		// drops them before any map sees them, so the options keep their defaults.
+		{"[map]\ngroundAwareGrid_count=1\n[map_groundAwareGrid_00_groundOpts]\n=\n==\nK\n", "", 1},
+		// Bytes after a NUL are never read (the text is a C string to MRPT).
+		{[] {
+			 static const char raw[] = "[map]\ngroundAwareGrid_count=1\n\0\xff\xfe[x]\n";
+			 return std::string(raw, sizeof(raw) - 1);  // with the NUL byte inside
+		 }(),
+		 "", 1},
+		{"[map]\nCElevation25DMap_count=1\n[map_CElevation25DMap_00_creationOpts]\nlabel=../../etc/passwd\n", "label",
+		 0}};
+	for (const auto& c : cases)
+	{
+		SCOPED_TRACE(c.text);
+		std::string err;
+		size_t maps = 0;
+		int K = 0;
+		try
 		{
-			EXPECT_NE(err, "") << "accepted: " << t;
+			mrpt::config::CConfigFileMemory cfg(c.text);
+			TSetOfMetricMapInitializers inits;
+			std::vector<gam::mapper::MapSpec> specs;
+			gam::mapper::loadMapDefinitions(cfg, "map", inits, specs);
+			CMultiMetricMap mm;
+			mm.setListOfMaps(inits);
+			maps = mm.maps.size();
+			if (auto ga = mm.mapByClass<CGroundAwareOccupancyGrid>()) K = ga->groundOptions().pipeline.rrt.iterations;
 		}
+		catch (const std::exception& e)
+		{
+			err = e.what();
+		}
+		if (c.error.empty())
+		{
+			EXPECT_EQ(err, "");
+			EXPECT_EQ(maps, c.maps);
+			EXPECT_EQ(K, 600) << "Table I's K";
+		}
+		else
+			EXPECT_NE(err.find(c.error), std::string::npos) << err;
 	}
 }

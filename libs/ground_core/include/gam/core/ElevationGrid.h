@@ -55,7 +55,7 @@ struct ElevationCell
 	float z_min = std::numeric_limits<float>::infinity();
 	float z_max = -std::numeric_limits<float>::infinity();
 	uint32_t count = 0;  ///< N_z, after outlier removal
-	float z_sum = 0;  ///< sum of z (for the mean)
+	float z_sum = 0;     ///< sum of z (for the mean)
 	/** Sum of the squared deviations from the cell's mean (Welford's update,
 	 * Chan's merge): the variance keeps its precision at any height. The sum
 	 * of z^2 it replaces gave E[z^2] - E[z]^2 in float, which at z = 10 m (an
