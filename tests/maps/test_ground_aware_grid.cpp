@@ -1,8 +1,14 @@
 // CGroundAwareOccupancyGrid on exact synthetic depth frames of known scenes.
+#include <gam/maps/GridIO.h>
 #include <gtest/gtest.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
+
+#include <mrpt/system/filesystem.h>
+
+#include <fstream>
+#include <map>
 
 #include "synthetic_scene.h"
 
@@ -392,4 +398,55 @@ TEST(GroundAwareGrid, MalformedObservationsThrowClearErrors)
 	const auto before = g.getRawMap();
 	EXPECT_NO_THROW(g.insertObservation(bad));
 	EXPECT_EQ(g.getRawMap(), before);
+}
+
+TEST(GroundAwareGrid, OneFrameOfFloorReadsFreeThroughMapServersRule)
+{
+	// Issue #30: the ROS map_server pair as a ROS user reads it. map_server
+	// (negate 0) takes p = (255 - pixel) / 255 as P(occupied); a pixel is
+	// occupied (100) if p > occupied_thresh, free (0) if p < free_thresh, and
+	// unknown (-1, trinary) or a scaled cost (scale) in between.
+	// One frame of floor gives the cell P(occ) = 0.5 - K_g = 0.2 (Table I:
+	// K_g = 0.3, the floor on the plane); the grid's int8 log-odds store it as
+	// pixel 204 or 203, p = 0.2 or 0.204. With ROS's customary free_thresh
+	// 0.196 that reads as not free; the written 0.25 reads it free. A hole
+	// cell of one frame, P = 0.5 + 0.5 K_m = 0.9 (pixel 25 or 26), is
+	// occupied (> 0.65); a cell never observed (pixel 128, p = 0.498), unknown.
+	CGroundAwareOccupancyGrid g;
+	g.insertObservation(*testscene::renderDepth(holeAndBoxScene(), kKinect));
+	const std::string dir = mrpt::system::getTempFileName() + "_rosmap";
+	mrpt::system::createDirectory(dir);
+	gam::maps::writeRosMap(g, dir + "/m.yaml", dir + "/m.pgm", "m.pgm");
+
+	std::map<std::string, std::string> yaml;
+	{
+		std::ifstream f(dir + "/m.yaml");
+		std::string line;
+		while (std::getline(f, line))
+			if (const auto c = line.find(": "); c != std::string::npos) yaml[line.substr(0, c)] = line.substr(c + 2);
+	}
+	const double occTh = std::stod(yaml.at("occupied_thresh")), freeTh = std::stod(yaml.at("free_thresh"));
+	EXPECT_EQ(yaml.at("negate"), "0");
+	// The PGM: P5, a comment line, "W H", 255, then rows from the top (highest y).
+	std::ifstream f(dir + "/m.pgm", std::ios::binary);
+	std::string magic, comment;
+	int W = 0, H = 0, maxv = 0;
+	f >> magic;
+	f.ignore();
+	std::getline(f, comment);
+	f >> W >> H >> maxv;
+	f.ignore();
+	std::vector<unsigned char> px(size_t(W) * size_t(H));
+	f.read(reinterpret_cast<char*>(px.data()), std::streamsize(px.size()));
+	ASSERT_EQ(magic, "P5");
+	ASSERT_EQ(W, int(g.getSizeX()));
+	auto mapServer = [&](double x, double y, double freeThresh) {
+		const int cx = g.x2idx(float(x)), cy = g.y2idx(float(y));
+		const double p = (255.0 - px[size_t(H - 1 - cy) * size_t(W) + size_t(cx)]) / 255.0;
+		return p > occTh ? 100 : p < freeThresh ? 0 : -1;
+	};
+	EXPECT_EQ(mapServer(1.0, -0.5, freeTh), 0) << "floor seen in one frame";
+	EXPECT_EQ(mapServer(1.0, -0.5, 0.196), -1) << "the customary 0.196 would call it unknown";
+	EXPECT_EQ(mapServer(2.2, 0.0, freeTh), 100) << "the hole";
+	EXPECT_EQ(mapServer(-5.0, 5.0, freeTh), -1) << "never observed";
 }

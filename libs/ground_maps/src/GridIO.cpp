@@ -51,8 +51,15 @@ void writeRosMap(
 	  << "resolution: " << g.getResolution() << "\n"
 	  << "origin: [" << g.getXMin() << ", " << g.getYMin() << ", 0.0]\n"
 	  << "negate: 0\n"
+	  // How map_server (and a ROS planner) reads each pixel, p = P(occupied):
+	  // occupied above 0.65, free below 0.25, between: unknown (trinary) or a
+	  // scaled cost (scale). One frame of floor gives p = 0.5 - K_g = 0.2 (Table
+	  // I, K_g = 0.3; 0.2 to 0.21 after the int8 log-odds), so the free
+	  // threshold must exceed it: ROS's customary 0.196 (gmapping's) read such
+	  // a cell as not free. One frame of a dense obstacle gives 0.5 + 0.5 K_m =
+	  // 0.9 > 0.65; a cell never observed, 0.5, stays between the two.
 	  << "occupied_thresh: 0.65\n"
-	  << "free_thresh: 0.196\n";
+	  << "free_thresh: 0.25\n";
 	y.flush();
 	if (!y) throw std::runtime_error("cannot write " + yamlPath);
 }
