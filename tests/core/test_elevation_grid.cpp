@@ -342,25 +342,29 @@ TEST(ElevationGridIdw, HandComputedWeightedAverages)
 	EXPECT_FLOAT_EQ(grid.surfaceHeight(6, 6), 3.0f);
 }
 
-TEST(ElevationGridIdw, PromotedEstimatesAreOneSampleVoxels)
+TEST(ElevationGridIdw, PromotedEstimatesCountTheirValidNeighbours)
 {
 	// idw_in_ism (the paper's densified map): the two estimates of the test
-	// above, 1.8 at (5,5) and 2.25 at (5,6), become observed cells of N_z = 1.
+	// above, 1.8 at (5,5) and 2.25 at (5,6), become observed cells whose N_z is
+	// the number of valid neighbour voxels they came from (paper SIV-A): each
+	// sees (4,5), (6,5) and (6,6) in its 3 x 3 window, so N_z = 3.
 	ElevationGrid grid = makeIdwGrid();
 	IdwParams p;
 	p.radius_cells = 1;
 	p.min_neighbours = 3;
 	ASSERT_EQ(grid.interpolateIdw(p), 2u);
-	EXPECT_EQ(grid.promoteIdwCells(), 2u);
+	EXPECT_EQ(grid.promoteIdwCells(p.radius_cells), 2u);
 	EXPECT_EQ(grid.observedCount(), 5u);
-	EXPECT_EQ(grid.cell(5, 5).count, 1u);
+	EXPECT_EQ(grid.cell(5, 5).count, 3u);
+	EXPECT_EQ(grid.cell(5, 6).count, 3u);
+	EXPECT_FLOAT_EQ(grid.cell(5, 5).variance(), 0.f);
 	EXPECT_NEAR(grid.cell(5, 5).z_min, 1.8, 1e-5);
 	EXPECT_NEAR(grid.cell(5, 5).z_max, 1.8, 1e-5);
 	EXPECT_NEAR(grid.cell(5, 6).mean(), 2.25, 1e-5);
 	EXPECT_FLOAT_EQ(grid.cell(5, 6).span(), 0.f);
 	// Measured cells are left as they were; a second call adds nothing.
 	EXPECT_EQ(grid.cell(4, 5).count, 1u);
-	EXPECT_EQ(grid.promoteIdwCells(), 0u);
+	EXPECT_EQ(grid.promoteIdwCells(p.radius_cells), 0u);
 	// The next frame starts empty.
 	grid.clear();
 	EXPECT_EQ(grid.observedCount(), 0u);

@@ -5,10 +5,13 @@
 // d_pth = 0.03, d_r = 0.05, N_th = 0.2, E_th = 0.05, d_n = 0.4), not from the code.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
 #include "gam/core/InverseSensorModel.h"
+#include "gam/core/PlaneFit.h"
 #include "gam/core/RrtGroundDetector.h"
 #include "test_helpers.h"
 
@@ -155,12 +158,22 @@ TEST(PaperIsm, SweepingEachRayOnceEqualsWalkingEveryVoxelsRay)
 	// compute() sweeps each ray bin once from far to near, keeping only the
 	// farthest ground voxel and the obstacle voxels whose evidence has not
 	// yet fallen to the grid's floor. Reference: every in-range voxel walks
-	// its own ray sample by sample with eq. (5), clamped to the floor, and
-	// the values combine per cell. Both must agree on every cell.
+	// its own ray sample by sample, and the values combine per cell. The
+	// reference is written here from the paper, not with the code's ray
+	// functions (RayFan, obstacleRay, groundRay: each checked by hand above):
+	//  - rays: 2 pi / B apart, B = ceil(4 pi R / d_r) (half a cell apart at
+	//    the range R); a voxel's ray is the nearest one to its direction;
+	//  - samples at r_k = (k + 1/2) d_r for r_k <= |c_v| (the voxel's 2D distance);
+	//  - eq. (4) P_rho = K_m / (1 + exp(-K_n (N_z - d_min) / V)), V = d_r^2 max(span, d_r);
+	//  - eq. (5) obstacle: max(P_rho, 1/2) exp(-(r - |c_v|)^2 / (2 sigma^2));
+	//  - eq. (6) ground: K_g + (1/2 - K_g) / (1 + exp(-(r - |c_v|)));
+	//  - a cell's values combine as the strongest (the grid's one update per
+	//    frame), each clamped to [0.001, 0.999].
 	const GridGeometry g = gamtest::makeGeometry(-1.0, -3.0, 0.05, 120, 120);
 	const Eigen::Vector3d sensor(-0.73, 0.11, 0.8);
 	const double range = 4.5;
-	const paper::RayFan fan(g.resolution, range);
+	const int bins = int(std::ceil(4.0 * M_PI * range / g.resolution));
+	const double dtheta = 2.0 * M_PI / bins;
 	std::mt19937 rng(7);
 	std::uniform_real_distribution<double> ux(-1.0, 5.0), uy(-3.0, 3.0), noise(-0.01, 0.01), u01(0, 1);
 	for (int round = 0; round < 3; round++)
@@ -186,8 +199,12 @@ TEST(PaperIsm, SweepingEachRayOnceEqualsWalkingEveryVoxelsRay)
 		std::vector<float> ref(g.cellCount(), 0.5f);
 		auto add = [&](int qx, int qy, double v) {
 			if (!g.inside(qx, qy)) return;
+			const float c = std::clamp(float(v), 0.001f, 0.999f);
 			float& e = ref[g.index(qx, qy)];
-			e = ism::combine(e, std::max(float(v), ism::kEvidenceFloor));
+			if (e > 0.5f || c > 0.5f)
+				e = std::max(e, c);
+			else
+				e = std::min(e, c);
 		};
 		for (uint32_t idx : grid.observedCells())
 		{
@@ -197,15 +214,18 @@ TEST(PaperIsm, SweepingEachRayOnceEqualsWalkingEveryVoxelsRay)
 			const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
 			const double dx = g.cx(cx) - sensor.x(), dy = g.cy(cy) - sensor.y();
 			const double cv = std::hypot(dx, dy);
-			const double rho = paper::densityConfidence(c.count, c.span(), p, g.resolution);
-			auto value = [&](double cd) {
-				return cls == VoxelClass::Ground ? paper::groundRay(cd, cv, p) : paper::obstacleRay(cd, cv, rho, p);
+			const double V = g.resolution * g.resolution * std::max(double(c.span()), g.resolution);
+			const double pRho = p.K_m / (1.0 + std::exp(-p.K_n * (double(c.count) - p.d_min) / V));
+			auto value = [&](double r) {
+				const double d = r - cv;
+				return cls == VoxelClass::Ground ? p.K_g + (0.5 - p.K_g) / (1.0 + std::exp(-d))
+												 : std::max(pRho, 0.5) * std::exp(-d * d / (2.0 * p.sigma2));
 			};
 			add(cx, cy, value(cv));
-			const double a = fan.angle(fan.binOf(dx, dy));
-			for (int k = fan.lastSample(cv); k >= 0; k--)
+			const double a = std::lround(std::atan2(dy, dx) / dtheta) * dtheta;
+			for (int k = 0; (k + 0.5) * g.resolution <= cv + 1e-9; k++)
 			{
-				const double r = fan.radius(k);
+				const double r = (k + 0.5) * g.resolution;
 				add(g.ix(sensor.x() + r * std::cos(a)), g.iy(sensor.y() + r * std::sin(a)), value(r));
 			}
 		}
@@ -227,25 +247,36 @@ TEST(PaperRrt, NormalAndElevationTestsAtTheirBoundaries)
 	RrtGroundDetector rrt(rp);
 	GroundNode parent;
 	parent.local = Plane{0, 0, 1, 0};  // z = 0
-	// E_th = 0.05 against the parent's plane at the new position.
-	EXPECT_TRUE(rrt.paperAccepts(parent, 0.4, 0, 0.0499f, Plane{0, 0, 1, -0.0499}));
-	EXPECT_FALSE(rrt.paperAccepts(parent, 0.4, 0, 0.0501f, Plane{0, 0, 1, -0.0501}));
+	parent.z = 0;
+	// Line 14 as printed: |plane_local(z) - x_near(z)| <= E_th = 0.05, the new
+	// local plane's height at the new node against the parent's height.
+	EXPECT_TRUE(rrt.paperElevationOk(parent, 0.4, 0, Plane{0, 0, 1, -0.0499}));
+	EXPECT_FALSE(rrt.paperElevationOk(parent, 0.4, 0, Plane{0, 0, 1, -0.0501}));
 	// N_th = 0.2 as sin of the angle between the normals: asin(0.2) = 11.537 deg.
 	auto tilted = [](double deg) {
 		const double t = gamtest::deg2rad(deg);
 		return Plane{-std::sin(t), 0, std::cos(t), 0};
 	};
-	EXPECT_TRUE(rrt.paperAccepts(parent, 0.4, 0, 0.0f, tilted(11.5)));   // sin = 0.19937
-	EXPECT_FALSE(rrt.paperAccepts(parent, 0.4, 0, 0.0f, tilted(11.6)));  // sin = 0.20108
-	// Against the parent's normal, not the vertical: a 20 deg patch joins a
-	// 10 deg parent (sin 10 deg = 0.1736), which the default's vertical test
-	// (sin 20 deg = 0.342 > 0.2) refuses. Parent plane through the origin; the
-	// new node at x = 0.4 on it: z = tan(10 deg) * 0.4 = 0.070530.
+	EXPECT_TRUE(rrt.paperNormalOk(parent, tilted(11.5)));   // sin = 0.19937
+	EXPECT_FALSE(rrt.paperNormalOk(parent, tilted(11.6)));  // sin = 0.20108
+	// Against the parent's normal, not the vertical: a 20 deg patch passes
+	// against a 10 deg parent (sin 10 deg = 0.1736), which the default's
+	// vertical test (sin 20 deg = 0.342 > 0.2) refuses.
 	GroundNode slope;
-	slope.local = tilted(10);
-	const float z = float(std::tan(gamtest::deg2rad(10)) * 0.4);
-	EXPECT_TRUE(rrt.paperAccepts(slope, 0.4, 0, z, tilted(20)));
-	EXPECT_FALSE(rrt.paperAccepts(slope, 0.4, 0, z, tilted(22)));  // sin 12 deg = 0.2079
+	slope.local = tilted(10);  // through the origin
+	slope.z = 0;
+	EXPECT_TRUE(rrt.paperNormalOk(slope, tilted(20)));
+	EXPECT_FALSE(rrt.paperNormalOk(slope, tilted(22)));  // sin 12 deg = 0.2079
+	// The printed elevation test on that 10 deg slope: a node d_n = 0.4 m up
+	// it, on the same plane, is tan(10 deg) * 0.4 = 0.0705 m above the parent,
+	// more than E_th: refused (the extrapolated reading of the parent's plane,
+	// used until issue #30, gave 0 and took it). A 7 deg slope gives
+	// tan(7 deg) * 0.4 = 0.0491: taken.
+	EXPECT_FALSE(rrt.paperElevationOk(slope, 0.4, 0, tilted(10)));
+	GroundNode seven;
+	seven.local = tilted(7);
+	seven.z = 0;
+	EXPECT_TRUE(rrt.paperElevationOk(seven, 0.4, 0, tilted(7)));
 }
 
 namespace
@@ -273,9 +304,11 @@ TEST(PaperRrt, StepsOfExactlyDnAndTheFallbackThroughANeighbour)
 	const ElevationGrid grid = noisyFloor(0.003);
 	RrtGpdParams rp;
 	rp.variant = MethodVariant::Paper;
-	// A tight E_th (the 3 mm noise makes a local plane's extrapolation miss it
-	// now and then) so that some new nodes fail against x_near.
-	rp.elevation_threshold = 0.004;
+	// A tight N_th (0.03: 1.7 deg; the 3 mm noise tilts a 3 x 3 local fit by
+	// about rms / (sqrt(6) d_r) = 0.003 / 0.122 = 0.025 rad) so that some new
+	// nodes fail the normal test against x_near; lines 17-22 then try the
+	// other nodes within d_n (only after the normal test, as printed).
+	rp.normal_threshold = 0.03;
 	RrtGroundDetector rrt(rp);
 	GroundDetection d;
 	rrt.detect(grid, GroundSeedHint{}, d);
@@ -353,4 +386,71 @@ TEST(PaperRrt, SearchWindowDriftsTowardTheNodes)
 	for (const GroundNode& n : d.nodes)
 		far = std::max(far, std::max(std::abs(double(n.x - d.nodes[0].x)), std::abs(double(n.y - d.nodes[0].y))));
 	EXPECT_GT(far, 1.0 + 0.4) << "the tree never left the seed's first window";
+}
+
+TEST(PaperRrt, NoneOfTheDefaultGuards)
+{
+	// Issue #30: rrt_variant = paper runs without the default's guards. Each
+	// case below is refused by the default and taken by the paper variant.
+	RrtGpdParams paperParams;
+	paperParams.variant = MethodVariant::Paper;
+
+	// 1. max_cell_std (5 cm): a floor whose every cell holds the samples
+	// -6 cm and +6 cm (std 6 cm, mean 0; two samples, below the 3-sigma
+	// rule's minimum count). The default finds no cell it trusts, the paper
+	// fits the cells' means: the plane z = 0.
+	{
+		ElevationGrid grid(gamtest::makeGeometry(-3, -3, 0.05, 120, 120));
+		BinnedPoints b;
+		for (int cy = 0; cy < 120; cy++)
+			for (int cx = 0; cx < 120; cx++)
+				for (float z : {-0.06f, 0.06f}) b.push(uint32_t(grid.geometry().index(cx, cy)), z);
+		gamtest::insertAll(grid, b);
+		GroundDetection dd, pd;
+		RrtGroundDetector(RrtGpdParams{}).detect(grid, GroundSeedHint{}, dd);
+		EXPECT_EQ(dd.status, GroundDetection::Status::NoValidSeed);
+		RrtGroundDetector(paperParams).detect(grid, GroundSeedHint{}, pd);
+		ASSERT_TRUE(pd.ok()) << pd.describe();
+		EXPECT_NEAR(pd.plane().heightAt(1, 1), 0.0, 1e-3);
+	}
+	// 2. The seed's expected height (seed_height_tolerance 0.3 m): the floor
+	// 0.5 m below where the robot expects it.
+	{
+		ElevationGrid grid(gamtest::makeGeometry(-3, -3, 0.05, 120, 120));
+		std::mt19937 rng(3);
+		BinnedPoints b;
+		gamtest::sampleSurface(
+			grid, -3, 3, -3, 3, [](double, double) { return -0.5; }, 4, 0.002, rng, b);
+		gamtest::insertAll(grid, b);
+		GroundDetection dd, pd;
+		RrtGroundDetector(RrtGpdParams{}).detect(grid, GroundSeedHint{}, dd);
+		EXPECT_EQ(dd.status, GroundDetection::Status::NoValidSeed);
+		RrtGroundDetector(paperParams).detect(grid, GroundSeedHint{}, pd);
+		ASSERT_TRUE(pd.ok()) << pd.describe();
+		EXPECT_NEAR(pd.plane().heightAt(0, 0), -0.5, 0.01);
+	}
+	// 3. RANSAC without the refit: the paper's plane is the best candidate,
+	// through three of the node centres; the default refits to the inliers.
+	{
+		std::vector<Eigen::Vector3d> pts;
+		std::mt19937 rng(5);
+		std::normal_distribution<double> n(0, 0.005);
+		for (int i = 0; i < 40; i++) pts.emplace_back(0.1 * (i % 8), 0.1 * (i / 8), n(rng));
+		RansacParams p;
+		p.inlier_distance = 0.05;
+		p.refine = false;
+		std::mt19937 r1(1);
+		const auto best = fitPlaneRansac(pts, p, r1);
+		ASSERT_TRUE(best);
+		int through = 0;
+		for (const auto& q : pts) through += std::abs(best->plane.signedDistance(q.x(), q.y(), q.z())) < 1e-9;
+		EXPECT_GE(through, 3) << "a candidate plane passes through its three points";
+		p.refine = true;
+		std::mt19937 r2(1);
+		const auto refit = fitPlaneRansac(pts, p, r2);
+		ASSERT_TRUE(refit);
+		through = 0;
+		for (const auto& q : pts) through += std::abs(refit->plane.signedDistance(q.x(), q.y(), q.z())) < 1e-9;
+		EXPECT_LT(through, 3) << "the least-squares plane of 40 noisy points passes through none of them";
+	}
 }

@@ -223,15 +223,33 @@ size_t ElevationGrid::interpolateIdw(const IdwParams& p)
 	return filled;
 }
 
-size_t ElevationGrid::promoteIdwCells()
+size_t ElevationGrid::promoteIdwCells(int radiusCells)
 {
-	size_t n = 0;
+	// Paper SIV-A: an interpolated voxel's N_z is the number of valid
+	// neighbour voxels it was interpolated from. Count them first (before any
+	// estimate becomes an observed cell), then promote.
+	const int r = std::max(0, radiusCells);
+	m_idwNeighbours.clear();
 	for (uint32_t i : m_idwTouched)
 	{
-		ElevationCell& c = m_cells[i];
+		const ElevationCell& c = m_cells[i];
+		uint32_t nb = 0;
+		if (!c.count && std::isfinite(c.z_idw))
+		{
+			const int cx = int(i % uint32_t(m_geom.nx)), cy = int(i / uint32_t(m_geom.nx));
+			for (int y = std::max(0, cy - r); y <= std::min(m_geom.ny - 1, cy + r); y++)
+				for (int x = std::max(0, cx - r); x <= std::min(m_geom.nx - 1, cx + r); x++)
+					nb += m_cells[m_geom.index(x, y)].count > 0;
+		}
+		m_idwNeighbours.push_back(nb);
+	}
+	size_t n = 0;
+	for (size_t k = 0; k < m_idwTouched.size(); k++)
+	{
+		ElevationCell& c = m_cells[m_idwTouched[k]];
 		if (c.count || !std::isfinite(c.z_idw)) continue;
-		c.add(c.z_idw);
-		m_touched.push_back(i);
+		for (uint32_t j = 0; j < std::max<uint32_t>(1, m_idwNeighbours[k]); j++) c.add(c.z_idw);
+		m_touched.push_back(m_idwTouched[k]);
 		n++;
 	}
 	return n;

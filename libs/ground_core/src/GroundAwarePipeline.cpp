@@ -104,11 +104,15 @@ const FrameResult& GroundAwarePipeline::process(
 	m_bins.clear();
 	m_result.samples = binSensorFrame(frame, m_params.projectionFilter(robot.z()), m_grid, m_projector, m_bins);
 	const auto t1 = clk::now();
-	m_result.points = m_grid.insert(m_bins, m_params.outliers);
+	// The paper's 3-sigma rule has no minimum band (the default's 5 mm keeps
+	// samples of a perfectly flat cell from being cut by round-off).
+	OutlierFilterParams outliers = m_params.outliers;
+	if (m_params.ism.model == MethodVariant::Paper) outliers.min_band = 0.f;
+	m_result.points = m_grid.insert(m_bins, outliers);
 	if (m_params.idw.radius_cells > 0)
 	{
 		m_grid.interpolateIdw(m_params.idw);
-		if (m_params.idw_in_ism) m_grid.promoteIdwCells();
+		if (m_params.idw_in_ism) m_grid.promoteIdwCells(m_params.idw.radius_cells);
 	}
 	const auto t2 = clk::now();
 

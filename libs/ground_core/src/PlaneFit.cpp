@@ -121,6 +121,11 @@ bool fitPlaneRansac(
 			res.inliers.push_back(i);
 			inl.push_back(pts[i]);
 		}
+	if (!p.refine)
+	{
+		res.plane = best;
+		return true;
+	}
 	const auto refined = fitPlaneTotalLeastSquares(inl);
 	res.plane = (refined && refined->horizontalNormal() <= p.max_horizontal_normal) ? *refined : best;
 	return true;

@@ -50,7 +50,8 @@ bool RrtGroundDetector::cellHeight(const ElevationGrid& grid, int cx, int cy, fl
 	const ElevationCell& c = grid.cell(cx, cy);
 	if (c.count)
 	{
-		if (c.variance() > float(m_params.max_cell_std * m_params.max_cell_std)) return false;
+		// (A default-only guard: the paper takes every cell the 3-sigma rule left.)
+		if (!paper() && c.variance() > float(m_params.max_cell_std * m_params.max_cell_std)) return false;
 		z = c.mean();
 		return true;
 	}
@@ -71,7 +72,9 @@ bool RrtGroundDetector::fitLocalPlane(const ElevationGrid& grid, int cx, int cy,
 			// Coordinates relative to the centre cell keep the fit well conditioned.
 			m_fitPts.emplace_back((x - cx) * g.resolution, (y - cy) * g.resolution, double(z));
 		}
-	if (int(m_fitPts.size()) < m_params.min_valid_cells) return false;
+	// The paper's local plane needs 3 non-collinear points (the fit refuses
+	// collinear ones); the default asks for min_valid_cells.
+	if (int(m_fitPts.size()) < (paper() ? 3 : m_params.min_valid_cells)) return false;
 	const auto p = fitHeightPlaneLeastSquares(m_fitPts, &rms);
 	if (!p) return false;
 	// Move the plane from centre-relative to grid coordinates.
@@ -81,7 +84,10 @@ bool RrtGroundDetector::fitLocalPlane(const ElevationGrid& grid, int cx, int cy,
 
 bool RrtGroundDetector::planarEnough(const Plane& local, double rms) const
 {
-	return !(rms > m_params.max_fit_rms || local.horizontalNormal() > m_params.normal_threshold);
+	// The paper's seed is "a valid ground cell": its local plane within N_th
+	// of the vertical; the fit's RMS is a default-only guard.
+	if (!paper() && rms > m_params.max_fit_rms) return false;
+	return local.horizontalNormal() <= m_params.normal_threshold;
 }
 
 bool RrtGroundDetector::childAt(
@@ -129,7 +135,8 @@ bool RrtGroundDetector::findSeed(const ElevationGrid& grid, const GroundSeedHint
 		if (!m_seedExcluded.empty() && m_seedExcluded[g.index(cx, cy)]) continue;
 		float z;
 		if (!cellHeight(grid, cx, cy, z)) continue;
-		if (std::abs(z - hint.floor_z) > m_params.seed_height_tolerance) continue;
+		// (Default only: the paper has no expected floor height for the seed.)
+		if (!paper() && std::abs(z - hint.floor_z) > m_params.seed_height_tolerance) continue;
 		Plane pl;
 		double rms;
 		if (!fitLocalPlane(grid, cx, cy, pl, rms) || !planarEnough(pl, rms)) continue;
@@ -153,7 +160,11 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 	reserveScratch(g);
 
 	m_seedExcluded.clear();
-	for (int attempt = 0; attempt < m_params.seed_attempts; attempt++)
+	// The paper grows one tree from one seed, and RANSAC needs 3 nodes; the
+	// default re-seeds a tree that stayed below min_nodes (a box top).
+	const int attempts = paper() ? 1 : m_params.seed_attempts;
+	const size_t minNodes = paper() ? 3 : m_params.min_nodes;
+	for (int attempt = 0; attempt < attempts; attempt++)
 	{
 		GroundNode seed;
 		if (!findSeed(grid, hint, seed))
@@ -169,7 +180,7 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 			growTreePaper(grid, seed, out);
 		else
 			growTree(grid, seed, out);
-		if (out.nodes.size() >= m_params.min_nodes) break;
+		if (out.nodes.size() >= minNodes) break;
 		// The seed was a small flat patch (a box top, a shelf board): exclude
 		// the area the tree covered and try the next candidate.
 		if (m_seedExcluded.empty()) m_seedExcluded.assign(g.cellCount(), 0);
@@ -183,7 +194,7 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 		}
 	}
 
-	if (out.nodes.size() < m_params.min_nodes)
+	if (out.nodes.size() < minNodes)
 	{
 		out.status = GroundDetection::Status::TooFewNodes;
 		return;
@@ -456,16 +467,23 @@ void RrtGroundDetector::growTree(const ElevationGrid& grid, const GroundNode& se
 	}
 }
 
-bool RrtGroundDetector::paperAccepts(const GroundNode& parent, double px, double py, float z, const Plane& pl) const
+bool RrtGroundDetector::paperElevationOk(const GroundNode& near, double px, double py, const Plane& pl) const
 {
-	// E_th: the new node's height against the parent's local plane there.
-	if (std::abs(double(z) - parent.local.heightAt(px, py)) > m_params.elevation_threshold) return false;
+	// Line 14 as printed: the new local plane's height at the new node against
+	// x_near's height (not x_near's plane extrapolated to the new node, the
+	// reading until issue #30: on a slope of more than E_th / d_n = 7 deg the
+	// printed test stops the tree).
+	return std::abs(pl.heightAt(px, py) - double(near.z)) <= m_params.elevation_threshold;
+}
+
+bool RrtGroundDetector::paperNormalOk(const GroundNode& node, const Plane& pl) const
+{
 	// N_th: the paper compares the new local normal with the parent's. As
 	// printed (n_new . n_near <= N_th) it would accept only normals nearly
 	// perpendicular to the parent's; we read it as the sine of the angle
 	// between them, |n_new x n_near| <= N_th (0.2 = 11.5 deg, the same angle
 	// the default variant allows against the vertical).
-	const Eigen::Vector3d a(pl.a, pl.b, pl.c), b(parent.local.a, parent.local.b, parent.local.c);
+	const Eigen::Vector3d a(pl.a, pl.b, pl.c), b(node.local.a, node.local.b, node.local.c);
 	return a.cross(b).norm() <= m_params.normal_threshold * a.norm() * b.norm();
 }
 
@@ -477,9 +495,11 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 	//    nodes (it drifts toward them), half side = the nodes' largest offset
 	//    from the centroid along the axis + window_margin;
 	//  - x_new = x_near + d_n (q - x_near) / |q - x_near|: always a d_n step;
-	//  - x_new joins as a child of x_near if it passes E_th and N_th against
-	//    x_near's local plane; else (lines 17-22) as a child of the first
-	//    other node within d_n of it, nearest first, against which it passes.
+	//  - x_new is kept only if its local plane's height is within E_th of
+	//    x_near's (line 14); it joins as a child of x_near if its normal
+	//    passes N_th against x_near's, else (lines 17-22) as a child of the
+	//    first other node within d_n of it, nearest first, whose normal it
+	//    passes.
 	const GridGeometry& g = grid.geometry();
 	startTree(g, seed, out);
 	PaperSearchWindow window;
@@ -510,12 +530,16 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 		double rms;
 		if (!fitLocalPlane(grid, cx, cy, pl, rms)) continue;
 		const double px = g.cx(cx), py = g.cy(cy);
+		// Line 14: the elevation test against x_near decides whether x_new is
+		// ground at all; line 15: the normal test against x_near; lines 17-22
+		// (only when the normal test failed): the other nodes within d_n of
+		// x_new, nearest first, by the normal test.
+		if (!paperElevationOk(near, px, py, pl)) continue;
 		int parent = -1;
-		if (paperAccepts(near, px, py, z, pl))
+		if (paperNormalOk(near, pl))
 			parent = int(nearIdx);
 		else
 		{
-			// Lines 17-22: the other nodes within d_n of x_new, nearest first.
 			m_candidates.clear();
 			for (uint32_t i = 0; i < out.nodes.size(); i++)
 			{
@@ -526,7 +550,7 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 			}
 			std::sort(m_candidates.begin(), m_candidates.end());
 			for (const auto& [d2, i] : m_candidates)
-				if (paperAccepts(out.nodes[i], px, py, z, pl))
+				if (paperNormalOk(out.nodes[i], pl))
 				{
 					parent = int(i);
 					break;
@@ -699,6 +723,13 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 	rp.iterations = m_params.ransac_iterations;
 	rp.inlier_distance = m_params.ransac_inlier_distance;
 	rp.max_horizontal_normal = m_params.normal_threshold;
+	if (paper())
+	{
+		// The paper's RANSAC: the plane of the largest consensus, as found
+		// (no tilt limit on the candidates, no refit to the inliers).
+		rp.max_horizontal_normal = 1.0;
+		rp.refine = false;
+	}
 	out.planes.reserve(size_t(m_params.max_planes));
 	out.plane_support.reserve(size_t(m_params.max_planes));
 	m_patchNodes.clear();
@@ -720,7 +751,8 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 	for (int round = 0; int(out.planes.size()) < maxPlanes && remaining.size() >= 3 && round < 2 * maxPlanes; round++)
 	{
 		const int k = int(out.planes.size());
-		rp.min_inliers = k == 0 ? std::max<size_t>(3, m_params.min_nodes / 2) : m_params.min_nodes_per_extra_plane;
+		rp.min_inliers =
+			k == 0 ? (paper() ? 3 : std::max<size_t>(3, m_params.min_nodes / 2)) : m_params.min_nodes_per_extra_plane;
 		if (k > 0 && m_params.min_nodes_per_extra_plane == 0) break;
 		pts.clear();
 		for (size_t i : remaining) pts.emplace_back(out.nodes[i].x, out.nodes[i].y, out.nodes[i].z);
@@ -779,7 +811,7 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 			keepUnflagged();
 			continue;
 		}
-		if (minorStd < 0.5 * m_params.expansion_distance)
+		if (!paper() && minorStd < 0.5 * m_params.expansion_distance)
 		{
 			Eigen::Vector3d n = Eigen::Vector3d::Zero(), c = Eigen::Vector3d::Zero();
 			for (size_t i : r.inliers)

@@ -238,9 +238,12 @@ class ElevationGrid
 	 * the observed cells grown by r. */
 	size_t interpolateIdw(const IdwParams& p);
 	/** Turns every cell that holds only an IDW estimate into an observed cell
-	 * of one sample at that height (the paper's densified map). Returns how
-	 * many. clear() and recenter() empty them like any observed cell. */
-	size_t promoteIdwCells();
+	 * at that height (the paper's densified map) whose sample count N_z is the
+	 * number of observed cells in its (2 radiusCells + 1)^2 window, the valid
+	 * neighbour voxels it was interpolated from (paper SIV-A; pass the IDW
+	 * radius). Returns how many. clear() and recenter() empty them like any
+	 * observed cell. */
+	size_t promoteIdwCells(int radiusCells);
 
 	/** Surface height of a cell for ground fitting: the mean of an observed cell,
 	 * else the IDW estimate; NaN if neither. */
@@ -269,6 +272,7 @@ class ElevationGrid
 	std::vector<uint32_t> m_frameTouched;
 	std::vector<float> m_filterMean, m_filterLimit;
 	std::vector<float> m_idwWeights;
+	std::vector<uint32_t> m_idwNeighbours;
 };
 
 }  // namespace gam

@@ -47,6 +47,9 @@ struct RansacParams
 	size_t min_inliers = 3;
 	/** Reject candidate planes tilted more than this (sin of the angle); 1 = any. */
 	double max_horizontal_normal = 1.0;
+	/** Refit the best candidate to its inliers (total least squares); false =
+	 * the candidate through 3 of the points, as plain RANSAC gives it. */
+	bool refine = true;
 };
 
 struct RansacResult

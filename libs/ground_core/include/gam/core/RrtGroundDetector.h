@@ -248,15 +248,25 @@ class RrtGroundDetector
 	/** Local least-squares plane of the s_x * s_y cells around (cx, cy), using
 	 * observed heights and IDW estimates. False if too few cells or degenerate. */
 	bool fitLocalPlane(const ElevationGrid& grid, int cx, int cy, Plane& plane, double& rms) const;
-	/** Paper variant (exposed for tests): may a node at (px, py) of height z
-	 * with local plane `pl` join the tree as a child of `parent`? E_th against
-	 * the parent's local plane, N_th against the parent's normal. */
-	bool paperAccepts(const GroundNode& parent, double px, double py, float z, const Plane& pl) const;
+	/** Paper variant, Algorithm 1 line 14 as printed (exposed for tests): the
+	 * new node's local plane at (px, py) is within E_th of x_near's height,
+	 * |plane_local(z) - x_near(z)| <= E_th. */
+	bool paperElevationOk(const GroundNode& near, double px, double py, const Plane& pl) const;
+	/** Paper variant, the normal test of lines 15 and 18 (exposed for tests):
+	 * the sine of the angle between the new local normal and `node`'s is at
+	 * most N_th (our reading: as printed, n_new . n_near <= N_th accepts only
+	 * nearly perpendicular normals). */
+	bool paperNormalOk(const GroundNode& node, const Plane& pl) const;
 
    private:
 	bool cellHeight(const ElevationGrid& grid, int cx, int cy, float& z) const;
 	/** A local fit the tree accepts: RMS within max_fit_rms, normal within N_th of vertical. */
 	bool planarEnough(const Plane& local, double rms) const;
+	/** rrt_variant = paper: Algorithm 1 and one RANSAC plane, without the
+	 * default's guards (max_cell_std, min_valid_cells, the seed's height and
+	 * RMS, re-seeding, min_nodes, RANSAC's tilt limit and refit, the
+	 * collinear-nodes rule). */
+	bool paper() const { return m_params.variant == MethodVariant::Paper; }
 	/** The child `parent` (index parentIdx) would get at cell (cx, cy): the
 	 * cell's height within E_th of the parent's local plane there, its own
 	 * local fit planarEnough(). False if a test fails (`child` undefined). */
