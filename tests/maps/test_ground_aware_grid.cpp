@@ -450,3 +450,22 @@ TEST(GroundAwareGrid, OneFrameOfFloorReadsFreeThroughMapServersRule)
 	EXPECT_EQ(mapServer(2.2, 0.0, freeTh), 100) << "the hole";
 	EXPECT_EQ(mapServer(-5.0, 5.0, freeTh), -1) << "never observed";
 }
+
+TEST(GroundAwareGrid, AScanThatGrowsTheGridFreesNoNewCellUnderTheWalkersRule)
+{
+	// Issue #31: the walker's rule reverted only the cells of the grid's old
+	// extent; a scan that grew the grid left the new cells it passed through
+	// free (17,589 cells of the ramp scenes, outside the scored area).
+	auto fan = planarScan(180.0, 181, CPose3D(0, 0, 0.3, 0, 0, 0));  // 181 beams: no upsampling
+	for (size_t i = 0; i < 181; i++) fan.setScanRange(i, 4.0f);
+	CGroundAwareOccupancyGrid g(-1, 1, -1, 1, 0.05f);
+	setScanRule(g, ScanRule::KeepCameraFloor);
+	ASSERT_TRUE(g.insertObservation(fan));
+	ASSERT_GT(g.getXMax(), 3.9f) << "the scan grew the grid";
+	size_t freed = 0;
+	for (auto c : g.getRawMap()) freed += c > 0;
+	EXPECT_EQ(freed, 0u) << "cells made free by a planar scan";
+	size_t occ = 0;
+	for (auto c : g.getRawMap()) occ += c < 0;
+	EXPECT_GE(occ, 150u) << "its hits still count (181 beams, one end cell each)";
+}
