@@ -388,12 +388,27 @@ TEST(PaperRrt, SearchWindowDriftsTowardTheNodes)
 	EXPECT_GT(far, 1.0 + 0.4) << "the tree never left the seed's first window";
 }
 
+namespace
+{
+/** The default finds no seed in `grid`; the paper's tree finds the ground at
+ * height z (within tol) under the robot. */
+void expectOnlyThePaperFindsGround(const ElevationGrid& grid, double z, double tol)
+{
+	RrtGpdParams paperParams;
+	paperParams.variant = MethodVariant::Paper;
+	GroundDetection dd, pd;
+	RrtGroundDetector(RrtGpdParams{}).detect(grid, GroundSeedHint{}, dd);
+	EXPECT_EQ(dd.status, GroundDetection::Status::NoValidSeed);
+	RrtGroundDetector(paperParams).detect(grid, GroundSeedHint{}, pd);
+	ASSERT_TRUE(pd.ok()) << pd.describe();
+	EXPECT_NEAR(pd.plane().heightAt(0.5, 0.5), z, tol);
+}
+}  // namespace
+
 TEST(PaperRrt, NoneOfTheDefaultGuards)
 {
 	// Issue #30: rrt_variant = paper runs without the default's guards. Each
 	// case below is refused by the default and taken by the paper variant.
-	RrtGpdParams paperParams;
-	paperParams.variant = MethodVariant::Paper;
 
 	// 1. max_cell_std (5 cm): a floor whose every cell holds the samples
 	// -6 cm and +6 cm (std 6 cm, mean 0; two samples, below the 3-sigma
@@ -406,12 +421,7 @@ TEST(PaperRrt, NoneOfTheDefaultGuards)
 			for (int cx = 0; cx < 120; cx++)
 				for (float z : {-0.06f, 0.06f}) b.push(uint32_t(grid.geometry().index(cx, cy)), z);
 		gamtest::insertAll(grid, b);
-		GroundDetection dd, pd;
-		RrtGroundDetector(RrtGpdParams{}).detect(grid, GroundSeedHint{}, dd);
-		EXPECT_EQ(dd.status, GroundDetection::Status::NoValidSeed);
-		RrtGroundDetector(paperParams).detect(grid, GroundSeedHint{}, pd);
-		ASSERT_TRUE(pd.ok()) << pd.describe();
-		EXPECT_NEAR(pd.plane().heightAt(1, 1), 0.0, 1e-3);
+		expectOnlyThePaperFindsGround(grid, 0.0, 1e-3);
 	}
 	// 2. The seed's expected height (seed_height_tolerance 0.3 m): the floor
 	// 0.5 m below where the robot expects it.
@@ -422,12 +432,7 @@ TEST(PaperRrt, NoneOfTheDefaultGuards)
 		gamtest::sampleSurface(
 			grid, -3, 3, -3, 3, [](double, double) { return -0.5; }, 4, 0.002, rng, b);
 		gamtest::insertAll(grid, b);
-		GroundDetection dd, pd;
-		RrtGroundDetector(RrtGpdParams{}).detect(grid, GroundSeedHint{}, dd);
-		EXPECT_EQ(dd.status, GroundDetection::Status::NoValidSeed);
-		RrtGroundDetector(paperParams).detect(grid, GroundSeedHint{}, pd);
-		ASSERT_TRUE(pd.ok()) << pd.describe();
-		EXPECT_NEAR(pd.plane().heightAt(0, 0), -0.5, 0.01);
+		expectOnlyThePaperFindsGround(grid, -0.5, 0.01);
 	}
 	// 3. RANSAC without the refit: the paper's plane is the best candidate,
 	// through three of the node centres; the default refits to the inliers.
