@@ -13,6 +13,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -175,9 +176,11 @@ const char* stateName(mrpt::nav::CAbstractNavigator::TState s)
 }
 }  // namespace
 
-ReactiveResult runReactiveNavigation(
-	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start, const mrpt::math::TPoint2D& goal,
-	const ReactiveOptions& opts)
+namespace
+{
+/** MRPT's example navigator configuration with the walker's footprint, speed
+ * and PTG range. Throws if the base config is missing. */
+mrpt::config::CConfigFileMemory navigatorConfig(const ReactiveOptions& opts)
 {
 	std::ifstream f(opts.baseConfig);
 	if (!f) throw std::runtime_error("cannot read the reactive navigator config " + opts.baseConfig);
@@ -199,42 +202,135 @@ ReactiveResult runReactiveNavigation(
 		cfg.write("CReactiveNavigationSystem", mrpt::format("PTG%d_refDistance", i), opts.refDistance);
 		cfg.write("CReactiveNavigationSystem", mrpt::format("PTG%d_v_max_mps", i), opts.maxSpeed);
 	}
+	return cfg;
+}
 
+/** A navigator for `robot`, configured and initialised. */
+std::unique_ptr<mrpt::nav::CReactiveNavigationSystem> makeNavigator(
+	mrpt::nav::CRobot2NavInterface& robot, const ReactiveOptions& opts)
+{
+	const auto cfg = navigatorConfig(opts);
+	auto nav = std::make_unique<mrpt::nav::CReactiveNavigationSystem>(robot, false, false);
+	nav->setMinLoggingLevel(mrpt::system::LVL_ERROR);
+	nav->loadConfigFile(cfg);
+	// not read from the .ini by MRPT 2.5.8: set it here (else ReacNavGrid_*.dat.gz land in the cwd)
+	nav->params_abstract_ptg_navigator.ptg_cache_files_directory = opts.cacheDir;
+	nav->initialize();
+	return nav;
+}
+
+/** The delay logger dumps its table when destroyed: keep the console quiet. */
+void quietDelays(mrpt::nav::CReactiveNavigationSystem& nav)
+{
+	auto& delays = const_cast<mrpt::system::CTimeLogger&>(nav.getDelaysTimeLogger());
+	delays.clear(true);
+	delays.enable(false);
+}
+}  // namespace
+
+ReactiveResult runReactiveNavigation(
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start, const mrpt::math::TPoint2D& goal,
+	const ReactiveOptions& opts)
+{
 	mrpt::kinematics::CVehicleSimul_DiffDriven sim;
 	sim.setCurrentGTPose(start);
 	GridSensingRobot robot(sim, grid, opts.obstacles);
 	robot.setMinLoggingLevel(mrpt::system::LVL_ERROR);
-	mrpt::nav::CReactiveNavigationSystem nav(robot, false, false);
-	nav.setMinLoggingLevel(mrpt::system::LVL_ERROR);
-	nav.loadConfigFile(cfg);
-	// not read from the .ini by MRPT 2.5.8: set it here (else ReacNavGrid_*.dat.gz land in the cwd)
-	nav.params_abstract_ptg_navigator.ptg_cache_files_directory = opts.cacheDir;
-	nav.initialize();
+	const auto nav = makeNavigator(robot, opts);
 
 	mrpt::nav::CAbstractNavigator::TNavigationParams np;
 	np.target.target_coords = mrpt::math::TPose2D(goal.x, goal.y, 0);
 	np.target.targetAllowedDistance = opts.targetAllowedDistance;
 	np.target.targetIsRelative = false;
-	nav.navigate(&np);
+	nav->navigate(&np);
 
 	ReactiveResult r;
 	r.trajectory.push_back(sim.getCurrentGTPose());
 	for (double t = 0; t < opts.maxTime; t += opts.dt)
 	{
-		nav.navigationStep();
+		nav->navigationStep();
 		sim.simulateOneTimeStep(opts.dt);
 		r.trajectory.push_back(sim.getCurrentGTPose());
 		r.seconds = t + opts.dt;
-		if (nav.getCurrentState() != mrpt::nav::CAbstractNavigator::NAVIGATING) break;
+		if (nav->getCurrentState() != mrpt::nav::CAbstractNavigator::NAVIGATING) break;
 	}
-	r.endState = stateName(nav.getCurrentState());
-	// the delay logger dumps its table when destroyed: keep the console quiet
-	auto& delays = const_cast<mrpt::system::CTimeLogger&>(nav.getDelaysTimeLogger());
-	delays.clear(true);
-	delays.enable(false);
+	r.endState = stateName(nav->getCurrentState());
+	quietDelays(*nav);
 	const auto& p = r.trajectory.back();
-	r.reached = nav.getCurrentState() == mrpt::nav::CAbstractNavigator::IDLE &&
+	r.reached = nav->getCurrentState() == mrpt::nav::CAbstractNavigator::IDLE &&
 				std::hypot(p.x - goal.x, p.y - goal.y) <= opts.targetAllowedDistance + 0.1;
+	return r;
+}
+
+ClosedLoopResult runClosedLoopNavigation(
+	const gam::sim::SceneFile& sf, mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start,
+	const mrpt::math::TPoint2D& goal, const ClosedLoopOptions& opts)
+{
+	const ReactiveOptions& ro = opts.reactive;
+	mrpt::kinematics::CVehicleSimul_DiffDriven sim;
+	sim.setCurrentGTPose(start);
+	GridSensingRobot robot(sim, grid, ro.obstacles);
+	robot.setMinLoggingLevel(mrpt::system::LVL_ERROR);
+	const auto nav = makeNavigator(robot, ro);
+	std::mt19937 rng(opts.seed);
+
+	ClosedLoopResult r;
+	PlanResult plan;
+	double nextFrame = 0, nextPlan = 0;
+	// A cell along the rest of the plan that the grid now calls an obstacle.
+	auto planBlocked = [&]() {
+		for (const auto& p : plan.path)
+			if (grid.getPos(float(p.x), float(p.y)) < opts.plan.occupancyThreshold) return true;
+		return false;
+	};
+	r.trajectory.push_back(sim.getCurrentGTPose());
+	bool navigating = false;
+	for (double t = 0; t < ro.maxTime; t += ro.dt)
+	{
+		const mrpt::math::TPose2D gt = sim.getCurrentGTPose();
+		if (t >= nextFrame)
+		{
+			const auto obs = simulateKinect(sf, gam::sim::Pose2{gt.x, gt.y, gt.phi}, rng);
+			grid.insertObservation(*obs, mrpt::poses::CPose3D(gt.x, gt.y, 0, gt.phi, 0, 0));
+			r.frames++;
+			nextFrame += opts.frameInterval;
+		}
+		if (t >= nextPlan || (navigating && planBlocked()))
+		{
+			const PlanResult p = planPath(grid, {gt.x, gt.y}, goal, opts.plan);
+			nextPlan = t + opts.replanInterval;
+			if (p.found)
+			{
+				plan = p;
+				r.plans++;
+				// Waypoints every waypointSpacing along the path, and the goal.
+				mrpt::nav::TWaypointSequence wps;
+				double since = 0;
+				for (size_t i = 1; i < plan.path.size(); i++)
+				{
+					since += (plan.path[i] - plan.path[i - 1]).norm();
+					if (since >= opts.waypointSpacing && i + 1 < plan.path.size())
+					{
+						wps.waypoints.emplace_back(plan.path[i].x, plan.path[i].y, 0.5, true);
+						since = 0;
+					}
+				}
+				wps.waypoints.emplace_back(goal.x, goal.y, ro.targetAllowedDistance, false);
+				nav->navigateWaypoints(wps);
+				navigating = true;
+			}
+		}
+		nav->navigationStep();
+		sim.simulateOneTimeStep(ro.dt);
+		r.trajectory.push_back(sim.getCurrentGTPose());
+		r.seconds = t + ro.dt;
+		if (navigating && nav->getWaypointNavStatus().final_goal_reached) break;
+		if (navigating && nav->getCurrentState() == mrpt::nav::CAbstractNavigator::NAV_ERROR) break;
+	}
+	r.endState = stateName(nav->getCurrentState());
+	quietDelays(*nav);
+	const auto& p = r.trajectory.back();
+	r.reached = std::hypot(p.x - goal.x, p.y - goal.y) <= ro.targetAllowedDistance + 0.1;
 	return r;
 }
 

@@ -127,6 +127,35 @@ ReactiveResult runReactiveNavigation(
 	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start, const mrpt::math::TPoint2D& goal,
 	const ReactiveOptions& opts = {});
 
+struct ClosedLoopOptions
+{
+	ReactiveOptions reactive;      ///< the navigator, the simulated robot, dt and the time limit
+	PlanOptions plan;              ///< the global planner (PlannerSimple2D) on the current grid
+	double frameInterval = 0.1;    ///< simulated time between depth frames [s] (10 Hz)
+	double replanInterval = 2.0;   ///< the global plan is redone at least this often [s]
+	double waypointSpacing = 1.0;  ///< waypoints along the planned path [m]
+	unsigned seed = 1;             ///< sensor noise
+};
+
+struct ClosedLoopResult : ReactiveResult
+{
+	size_t frames = 0;  ///< depth frames rendered and inserted
+	int plans = 0;      ///< global plans computed (the first and the replans)
+};
+
+/** Issue #29, closed loop: the walker maps while it drives. Every
+ * frameInterval the scene's Kinect renders a depth frame at the robot's true
+ * pose, and `grid` (a fresh or stock-started grid; it is updated) inserts it
+ * at that pose (the odometry is exact). PlannerSimple2D plans on the current
+ * grid from the robot to `goal`; CReactiveNavigationSystem follows that plan
+ * as a waypoint sequence (navigateWaypoints), with obstacles from the current
+ * grid (senseObstacles), and the plan is redone every replanInterval and as
+ * soon as a cell along it turns into an obstacle. Ends when the last
+ * waypoint is reached, the navigator stops, or at opts.reactive.maxTime. */
+ClosedLoopResult runClosedLoopNavigation(
+	const gam::sim::SceneFile& sf, mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPose2D& start,
+	const mrpt::math::TPoint2D& goal, const ClosedLoopOptions& opts = {});
+
 /** Smallest distance [m] from a point to the union of the scene's holes
  * (0 inside one), sampled on a grid of `step` metres inside each hole. */
 double distanceToHoles(const gam::sim::Scene& scene, double x, double y, double step = 0.01);

@@ -97,12 +97,50 @@ int main(int argc, char** argv)
 			}
 		}
 
-		// Closed loop: MRPT's reactive navigator fed with each grid's obstacle points.
+		// MRPT's reactive navigator: on the grids mapped beforehand (static), then
+		// in closed loop, the grid built while the robot drives.
 		if (!argNoReactive.getValue())
 		{
 			gam::nav::ReactiveOptions ro;
 			ro.baseConfig = argReactiveCfg.getValue();
 			ro.cacheDir = std::filesystem::temp_directory_path().string();
+			gam::nav::ClosedLoopOptions co;
+			co.reactive = ro;
+			co.reactive.maxTime = 60;
+			co.plan = po;
+			co.seed = mo.seed;
+			gam::sim::SceneFile live = sf;
+			live.kinect.noise = mo.noise;
+			mrpt::maps::CGroundAwareOccupancyGrid gaLive;
+			mrpt::maps::CHeightBandOccupancyGrid hbLive;
+			struct LiveItem
+			{
+				const char* name;
+				mrpt::maps::COccupancyGridMap2D* grid;
+			} live_items[] = {{"ground_aware", &gaLive}, {"height_band", &hbLive}};
+			for (const auto& it : live_items)
+			{
+				const auto& ref = maps.groundAware;  // the same extent as the mapped grids
+				it.grid->setSize(ref.getXMin(), ref.getXMax(), ref.getYMin(), ref.getYMax(), ref.getResolution(), 0.5f);
+				const auto r = gam::nav::runClosedLoopNavigation(live, *it.grid, {start.x, start.y, 0}, goal, co);
+				double minHole = 1e9;
+				gam::nav::PlanResult traj;
+				for (const auto& p : r.trajectory)
+				{
+					minHole = std::min(minHole, gam::nav::distanceToHoles(sf.scene, p.x, p.y));
+					traj.path.emplace_back(p.x, p.y);
+				}
+				char buf[400];
+				std::snprintf(
+					buf, sizeof(buf),
+					"%-13s closed loop (mapping while driving, PlannerSimple2D waypoints, CReactiveNavigationSystem): "
+					"%s after %.1f s, %zu frames, %d plans, closest to a hole %.2f m -> %s\n",
+					it.name, r.reached ? "goal reached" : "goal NOT reached", r.seconds, r.frames, r.plans, minHole,
+					minHole < ro.robotHalfSize ? "FOOTPRINT OVER the hole" : "avoided the hole");
+				std::cout << buf;
+				if (!out.empty())
+					gam::nav::savePathPicture(*it.grid, traj, start, goal, out + "/" + it.name + "_closed_loop.png");
+			}
 			for (const auto& it : items)
 			{
 				const auto r = gam::nav::runReactiveNavigation(*it.grid, {start.x, start.y, 0}, goal, ro);
