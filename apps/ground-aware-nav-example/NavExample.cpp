@@ -138,15 +138,26 @@ namespace
 class GridSensingRobot : public mrpt::nav::CRobot2NavInterfaceForSimulator_DiffDriven
 {
    public:
+	/** `believed`: where the robot believes it is (its drifting odometry, kept
+	 * by the caller); nullptr = the true pose. */
 	GridSensingRobot(
 		mrpt::kinematics::CVehicleSimul_DiffDriven& sim, const mrpt::maps::COccupancyGridMap2D& grid,
-		const ObstacleOptions& oo)
-		: CRobot2NavInterfaceForSimulator_DiffDriven(sim), m_sim(sim), m_grid(grid), m_oo(oo)
+		const ObstacleOptions& oo, const mrpt::math::TPose2D* believed = nullptr)
+		: CRobot2NavInterfaceForSimulator_DiffDriven(sim), m_sim(sim), m_grid(grid), m_oo(oo), m_believed(believed)
 	{
+	}
+	mrpt::math::TPose2D believedPose() const { return m_believed ? *m_believed : m_sim.getCurrentGTPose(); }
+	bool getCurrentPoseAndSpeeds(
+		mrpt::math::TPose2D& pose, mrpt::math::TTwist2D& vel, mrpt::system::TTimeStamp& t, mrpt::math::TPose2D& odo,
+		std::string& frame) override
+	{
+		const bool ok = CRobot2NavInterfaceForSimulator_DiffDriven::getCurrentPoseAndSpeeds(pose, vel, t, odo, frame);
+		pose = believedPose();
+		return ok;
 	}
 	bool senseObstacles(mrpt::maps::CSimplePointsMap& obstacles, mrpt::system::TTimeStamp& t) override
 	{
-		obstacles = obstaclePointsRobotFrame(m_grid, mrpt::poses::CPose2D(m_sim.getCurrentGTPose()), m_oo);
+		obstacles = obstaclePointsRobotFrame(m_grid, mrpt::poses::CPose2D(believedPose()), m_oo);
 		t = mrpt::system::now();
 		return true;
 	}
@@ -161,6 +172,7 @@ class GridSensingRobot : public mrpt::nav::CRobot2NavInterfaceForSimulator_DiffD
 	mrpt::kinematics::CVehicleSimul_DiffDriven& m_sim;
 	const mrpt::maps::COccupancyGridMap2D& m_grid;
 	ObstacleOptions m_oo;
+	const mrpt::math::TPose2D* m_believed;
 };
 
 const char* stateName(mrpt::nav::CAbstractNavigator::TState s)
@@ -269,7 +281,9 @@ ClosedLoopResult runClosedLoopNavigation(
 	const ReactiveOptions& ro = opts.reactive;
 	mrpt::kinematics::CVehicleSimul_DiffDriven sim;
 	sim.setCurrentGTPose(start);
-	GridSensingRobot robot(sim, grid, ro.obstacles);
+	const bool drift = opts.odometryScaleError != 0 || opts.odometryYawDriftDegPerM != 0;
+	mrpt::math::TPose2D odometry = start;
+	GridSensingRobot robot(sim, grid, ro.obstacles, drift ? &odometry : nullptr);
 	robot.setMinLoggingLevel(mrpt::system::LVL_ERROR);
 	const auto nav = makeNavigator(robot, ro);
 	std::mt19937 rng(opts.seed);
@@ -287,17 +301,18 @@ ClosedLoopResult runClosedLoopNavigation(
 	bool navigating = false;
 	for (double t = 0; t < ro.maxTime; t += ro.dt)
 	{
-		const mrpt::math::TPose2D gt = sim.getCurrentGTPose();
+		const mrpt::math::TPose2D gt = sim.getCurrentGTPose(), known = robot.believedPose();
 		if (t >= nextFrame)
 		{
+			// Rendered where the robot is, inserted where it believes it is.
 			const auto obs = simulateKinect(sf, gam::sim::Pose2{gt.x, gt.y, gt.phi}, rng);
-			grid.insertObservation(*obs, mrpt::poses::CPose3D(gt.x, gt.y, 0, gt.phi, 0, 0));
+			grid.insertObservation(*obs, mrpt::poses::CPose3D(known.x, known.y, 0, known.phi, 0, 0));
 			r.frames++;
 			nextFrame += opts.frameInterval;
 		}
 		if (t >= nextPlan || (navigating && planBlocked()))
 		{
-			const PlanResult p = planPath(grid, {gt.x, gt.y}, goal, opts.plan);
+			const PlanResult p = planPath(grid, {known.x, known.y}, goal, opts.plan);
 			nextPlan = t + opts.replanInterval;
 			if (p.found)
 			{
@@ -322,6 +337,16 @@ ClosedLoopResult runClosedLoopNavigation(
 		}
 		nav->navigationStep();
 		sim.simulateOneTimeStep(ro.dt);
+		if (drift)
+		{
+			// The true step in the robot frame, as the odometry measures it.
+			const mrpt::poses::CPose2D step = mrpt::poses::CPose2D(sim.getCurrentGTPose()) - mrpt::poses::CPose2D(gt);
+			const double dist = std::hypot(step.x(), step.y());
+			const mrpt::poses::CPose2D measured(
+				step.x() * (1 + opts.odometryScaleError), step.y() * (1 + opts.odometryScaleError),
+				step.phi() + mrpt::DEG2RAD(opts.odometryYawDriftDegPerM) * dist);
+			odometry = (mrpt::poses::CPose2D(odometry) + measured).asTPose();
+		}
 		r.trajectory.push_back(sim.getCurrentGTPose());
 		r.seconds = t + ro.dt;
 		if (navigating && nav->getWaypointNavStatus().final_goal_reached) break;
@@ -331,6 +356,8 @@ ClosedLoopResult runClosedLoopNavigation(
 	quietDelays(*nav);
 	const auto& p = r.trajectory.back();
 	r.reached = std::hypot(p.x - goal.x, p.y - goal.y) <= ro.targetAllowedDistance + 0.1;
+	const mrpt::math::TPose2D odo = robot.believedPose();
+	r.finalOdometryError = std::hypot(odo.x - p.x, odo.y - p.y);
 	return r;
 }
 

@@ -135,18 +135,27 @@ struct ClosedLoopOptions
 	double replanInterval = 2.0;   ///< the global plan is redone at least this often [s]
 	double waypointSpacing = 1.0;  ///< waypoints along the planned path [m]
 	unsigned seed = 1;             ///< sensor noise
+	/** Odometry drift: the odometry integrates the true motion with its
+	 * distance scaled by (1 + odometryScaleError) and its heading turned by
+	 * odometryYawDriftDegPerM degrees per metre travelled. With drift the
+	 * robot knows its odometry only: frames are inserted, plans start and
+	 * obstacles are sensed at the odometry pose; the trajectory (falls,
+	 * arrival) is the true one. 0, 0 = exact odometry. */
+	double odometryScaleError = 0;
+	double odometryYawDriftDegPerM = 0;
 };
 
 struct ClosedLoopResult : ReactiveResult
 {
-	size_t frames = 0;  ///< depth frames rendered and inserted
-	int plans = 0;      ///< global plans computed (the first and the replans)
+	size_t frames = 0;              ///< depth frames rendered and inserted
+	int plans = 0;                  ///< global plans computed (the first and the replans)
+	double finalOdometryError = 0;  ///< |odometry - true| at the end [m]
 };
 
 /** Issue #29, closed loop: the walker maps while it drives. Every
  * frameInterval the scene's Kinect renders a depth frame at the robot's true
  * pose, and `grid` (a fresh or stock-started grid; it is updated) inserts it
- * at that pose (the odometry is exact). PlannerSimple2D plans on the current
+ * at the odometry pose (exact unless opts sets a drift). PlannerSimple2D plans on the current
  * grid from the robot to `goal`; CReactiveNavigationSystem follows that plan
  * as a waypoint sequence (navigateWaypoints), with obstacles from the current
  * grid (senseObstacles), and the plan is redone every replanInterval and as
