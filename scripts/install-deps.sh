@@ -10,7 +10,7 @@
 #          ~280 packages, ~210 MB, instead of ~740, ~430 MB).
 #   all    everything: the demo's packages plus the whole MRPT (its apps and
 #          data), wxWidgets (ground-aware-viewer), GoogleTest, Google
-#          Benchmark, Xvfb, clang (sanitizers, fuzzers, clang-format) and the
+#          Benchmark, Xvfb, GNU time, clang (sanitizers, fuzzers, clang-format) and the
 #          Python modules of rawlog_tools. scripts/run-tests.sh and CI need all.
 #   --check  install nothing: exit 0 if every package of the groups is
 #          installed, 1 if not.
@@ -27,6 +27,7 @@ REST_PKGS=(
   libwxgtk3.2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth
+  time  # /usr/bin/time -v: rawlog_tools/gam-long-traversal (test LongTraversal.*)
   clang libclang-rt-14-dev clang-format
   python3-rosbag python3-sensor-msgs python3-nav-msgs python3-tf2-msgs python3-geometry-msgs
   python3-matplotlib  # only for the plot of rawlog_tools/gam-detection-range (doc/figures/detection-range.png)
