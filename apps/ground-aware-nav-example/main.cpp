@@ -30,6 +30,19 @@ mrpt::math::TPoint2D parseXY(const std::string& s, const char* what)
 		throw std::invalid_argument(std::string("bad ") + what + " '" + s + "' (expected X,Y)");
 	return {x, y};
 }
+
+/** The closest a trajectory comes to a hole [m]; `traj` gets its points (for the picture). */
+double trajectoryToHoles(
+	const gam::sim::Scene& scene, const std::vector<mrpt::math::TPose2D>& trajectory, gam::nav::PlanResult& traj)
+{
+	double minHole = 1e9;
+	for (const auto& p : trajectory)
+	{
+		minHole = std::min(minHole, gam::nav::distanceToHoles(scene, p.x, p.y));
+		traj.path.emplace_back(p.x, p.y);
+	}
+	return minHole;
+}
 }  // namespace
 
 int main(int argc, char** argv)
@@ -123,13 +136,8 @@ int main(int argc, char** argv)
 				const auto& ref = maps.groundAware;  // the same extent as the mapped grids
 				it.grid->setSize(ref.getXMin(), ref.getXMax(), ref.getYMin(), ref.getYMax(), ref.getResolution(), 0.5f);
 				const auto r = gam::nav::runClosedLoopNavigation(live, *it.grid, {start.x, start.y, 0}, goal, co);
-				double minHole = 1e9;
 				gam::nav::PlanResult traj;
-				for (const auto& p : r.trajectory)
-				{
-					minHole = std::min(minHole, gam::nav::distanceToHoles(sf.scene, p.x, p.y));
-					traj.path.emplace_back(p.x, p.y);
-				}
+				const double minHole = trajectoryToHoles(sf.scene, r.trajectory, traj);
 				char buf[400];
 				std::snprintf(
 					buf, sizeof(buf),
@@ -144,13 +152,8 @@ int main(int argc, char** argv)
 			for (const auto& it : items)
 			{
 				const auto r = gam::nav::runReactiveNavigation(*it.grid, {start.x, start.y, 0}, goal, ro);
-				double minHole = 1e9;
 				gam::nav::PlanResult traj;
-				for (const auto& p : r.trajectory)
-				{
-					minHole = std::min(minHole, gam::nav::distanceToHoles(sf.scene, p.x, p.y));
-					traj.path.emplace_back(p.x, p.y);
-				}
+				const double minHole = trajectoryToHoles(sf.scene, r.trajectory, traj);
 				char buf[300];
 				std::snprintf(
 					buf, sizeof(buf),
