@@ -538,21 +538,8 @@ int main(int argc, char** argv)
 							frameTruth->sweep(gt, from, from + len * dir.head<2>().normalized(), 2);
 						}
 				}
-				auto l = mrpt::obs::CObservation2DRangeScan::Create();
-				l->sensorLabel = "LEDDAR";
+				auto l = toLeddarObservation(sf.leddar, ls, ledPose);
 				l->timestamp = ts;
-				l->aperture = float(sf.leddar.hfov_deg * M_PI / 180.0);
-				l->rightToLeft = true;
-				l->maxRange = float(sf.leddar.max_range);
-				l->stdError = float(sf.leddar.sigma);
-				l->beamAperture = float(sf.leddar.hfov_deg / sf.leddar.segments * M_PI / 180.0);
-				l->sensorPose = ledPose;
-				l->resizeScan(size_t(sf.leddar.segments));
-				for (int s = 0; s < sf.leddar.segments; s++)
-				{
-					l->setScanRange(size_t(s), ls.valid[size_t(s)] ? ls.range[size_t(s)] : 0.0f);
-					l->setScanRangeValidity(size_t(s), ls.valid[size_t(s)]);
-				}
 				ar << *l;
 				entry++;
 			}

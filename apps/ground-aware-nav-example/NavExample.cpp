@@ -287,6 +287,7 @@ ClosedLoopResult runClosedLoopNavigation(
 	robot.setMinLoggingLevel(mrpt::system::LVL_ERROR);
 	const auto nav = makeNavigator(robot, ro);
 	std::mt19937 rng(opts.seed);
+	const gam::sim::LeddarModel leddar(sf.leddar);
 
 	ClosedLoopResult r;
 	PlanResult plan;
@@ -306,7 +307,17 @@ ClosedLoopResult runClosedLoopNavigation(
 		{
 			// Rendered where the robot is, inserted where it believes it is.
 			const auto obs = simulateKinect(sf, gam::sim::Pose2{gt.x, gt.y, gt.phi}, rng);
-			grid.insertObservation(*obs, mrpt::poses::CPose3D(known.x, known.y, 0, known.phi, 0, 0));
+			const mrpt::poses::CPose3D believed(known.x, known.y, 0, known.phi, 0, 0);
+			grid.insertObservation(*obs, believed);
+			if (sf.leddar_enabled)
+			{
+				// The walker's Leddar, in the same step (the grid's own rule for 2D scans).
+				const gam::sim::Pose3 robot3 = gam::sim::Pose3::fromXYZYPR(gt.x, gt.y, 0, gt.phi, 0, 0);
+				const gam::sim::LeddarScan ls = leddar.scan(sf.scene, robot3 * sf.leddar_pose, rng);
+				grid.insertObservation(
+					*gam::sim::toLeddarObservation(sf.leddar, ls, toCPose3D(sf.leddar_pose)), believed);
+				r.leddarScans++;
+			}
 			r.frames++;
 			nextFrame += opts.frameInterval;
 		}

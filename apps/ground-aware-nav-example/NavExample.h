@@ -148,13 +148,15 @@ struct ClosedLoopOptions
 struct ClosedLoopResult : ReactiveResult
 {
 	size_t frames = 0;              ///< depth frames rendered and inserted
+	size_t leddarScans = 0;         ///< Leddar scans (one with each depth frame if the scene has a Leddar)
 	int plans = 0;                  ///< global plans computed (the first and the replans)
 	double finalOdometryError = 0;  ///< |odometry - true| at the end [m]
 };
 
 /** Issue #29, closed loop: the walker maps while it drives. Every
  * frameInterval the scene's Kinect renders a depth frame at the robot's true
- * pose, and `grid` (a fresh or stock-started grid; it is updated) inserts it
+ * pose, with the scene's Leddar scan if it has one, and `grid` (a fresh or
+ * stock-started grid; it is updated) inserts them
  * at the odometry pose (exact unless opts sets a drift). PlannerSimple2D plans on the current
  * grid from the robot to `goal`; CReactiveNavigationSystem follows that plan
  * as a waypoint sequence (navigateWaypoints), with obstacles from the current

@@ -1,8 +1,10 @@
-// Ground-aware mapping for MRPT -- MRPT glue of the simulator (header-only).
+// Ground-aware mapping for MRPT -- MRPT glue of the simulator (header-only):
+// its Kinect frames and Leddar scans as MRPT observations.
 // The ground_sim library itself is pure; this header needs mrpt::obs, so only
 // programs that link MRPT include it (gam-simulate, the navigation example).
 #pragma once
 
+#include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/poses/CPose3D.h>
 
@@ -45,6 +47,29 @@ inline mrpt::obs::CObservation3DRangeScan::Ptr toKinectObservation(
 		}
 	if (validPixels) *validPixels = valid;
 	return k;
+}
+
+/** A simulated Leddar scan as MRPT's CObservation2DRangeScan: one range per
+ * segment (0 and invalid where no echo), MRPT's angle convention
+ * (rightToLeft, aperture = the horizontal field of view), `sensorPose` on the robot. */
+inline mrpt::obs::CObservation2DRangeScan::Ptr toLeddarObservation(
+	const LeddarParams& leddar, const LeddarScan& ls, const mrpt::poses::CPose3D& sensorPose)
+{
+	auto l = mrpt::obs::CObservation2DRangeScan::Create();
+	l->sensorLabel = "LEDDAR";
+	l->aperture = float(leddar.hfov_deg * M_PI / 180.0);
+	l->rightToLeft = true;
+	l->maxRange = float(leddar.max_range);
+	l->stdError = float(leddar.sigma);
+	l->beamAperture = float(leddar.hfov_deg / leddar.segments * M_PI / 180.0);
+	l->sensorPose = sensorPose;
+	l->resizeScan(size_t(leddar.segments));
+	for (int s = 0; s < leddar.segments; s++)
+	{
+		l->setScanRange(size_t(s), ls.valid[size_t(s)] ? ls.range[size_t(s)] : 0.0f);
+		l->setScanRangeValidity(size_t(s), ls.valid[size_t(s)]);
+	}
+	return l;
 }
 
 }  // namespace gam::sim
