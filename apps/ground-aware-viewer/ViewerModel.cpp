@@ -110,14 +110,9 @@ void ViewerModel::applyInitialMap()
 
 void ViewerModel::loadInitialMap(const std::string& path)
 {
-	if (path.empty())
-	{
-		m_initialMap.reset();
-		m_initialMapPath.clear();
-		loadConfig(m_configPath, m_configSection);
-		return;
-	}
-	m_initialMap = std::make_shared<mrpt::maps::COccupancyGridMap2D>(gam::maps::readStockGrid(path));
+	// Read first: a bad file throws before anything changes.
+	m_initialMap =
+		path.empty() ? nullptr : std::make_shared<mrpt::maps::COccupancyGridMap2D>(gam::maps::readStockGrid(path));
 	m_initialMapPath = path;
 	loadConfig(m_configPath, m_configSection);
 }

@@ -45,6 +45,13 @@ ProjectionFilter PipelineParams::projectionFilter(double robotZ) const
 	return f;
 }
 
+OutlierFilterParams PipelineParams::outlierFilter() const
+{
+	OutlierFilterParams f = outliers;
+	if (ism.model == MethodVariant::Paper) f.min_band = 0.f;
+	return f;
+}
+
 GroundAwarePipeline::GroundAwarePipeline(const PipelineParams& p) { setParams(p); }
 
 void GroundAwarePipeline::setParams(const PipelineParams& p)
@@ -104,11 +111,7 @@ const FrameResult& GroundAwarePipeline::process(
 	m_bins.clear();
 	m_result.samples = binSensorFrame(frame, m_params.projectionFilter(robot.z()), m_grid, m_projector, m_bins);
 	const auto t1 = clk::now();
-	// The paper's 3-sigma rule has no minimum band (the default's 5 mm keeps
-	// samples of a perfectly flat cell from being cut by round-off).
-	OutlierFilterParams outliers = m_params.outliers;
-	if (m_params.ism.model == MethodVariant::Paper) outliers.min_band = 0.f;
-	m_result.points = m_grid.insert(m_bins, outliers);
+	m_result.points = m_grid.insert(m_bins, m_params.outlierFilter());
 	if (m_params.idw.radius_cells > 0)
 	{
 		m_grid.interpolateIdw(m_params.idw);

@@ -163,7 +163,6 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 	// The paper grows one tree from one seed, and RANSAC needs 3 nodes; the
 	// default re-seeds a tree that stayed below min_nodes (a box top).
 	const int attempts = paper() ? 1 : m_params.seed_attempts;
-	const size_t minNodes = paper() ? 3 : m_params.min_nodes;
 	for (int attempt = 0; attempt < attempts; attempt++)
 	{
 		GroundNode seed;
@@ -180,7 +179,7 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 			growTreePaper(grid, seed, out);
 		else
 			growTree(grid, seed, out);
-		if (out.nodes.size() >= minNodes) break;
+		if (out.nodes.size() >= minNodes()) break;
 		// The seed was a small flat patch (a box top, a shelf board): exclude
 		// the area the tree covered and try the next candidate.
 		if (m_seedExcluded.empty()) m_seedExcluded.assign(g.cellCount(), 0);
@@ -194,7 +193,7 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 		}
 	}
 
-	if (out.nodes.size() < minNodes)
+	if (out.nodes.size() < minNodes())
 	{
 		out.status = GroundDetection::Status::TooFewNodes;
 		return;
@@ -751,8 +750,7 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 	for (int round = 0; int(out.planes.size()) < maxPlanes && remaining.size() >= 3 && round < 2 * maxPlanes; round++)
 	{
 		const int k = int(out.planes.size());
-		rp.min_inliers =
-			k == 0 ? (paper() ? 3 : std::max<size_t>(3, m_params.min_nodes / 2)) : m_params.min_nodes_per_extra_plane;
+		rp.min_inliers = k == 0 ? std::max<size_t>(3, minNodes() / 2) : m_params.min_nodes_per_extra_plane;
 		if (k > 0 && m_params.min_nodes_per_extra_plane == 0) break;
 		pts.clear();
 		for (size_t i : remaining) pts.emplace_back(out.nodes[i].x, out.nodes[i].y, out.nodes[i].z);

@@ -209,7 +209,6 @@ void CGroundAwareOccupancyGrid::resetRunState()
 	m_missingLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
 	m_scanOnlyLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
 	m_positiveSeen.clear();
-	m_mounts.clear();
 	m_depthFrames = 0;
 	m_scansBeforeDepth = 0;
 	m_warnedNoFreeSpace = false;
@@ -618,13 +617,9 @@ void CGroundAwareOccupancyGrid::serializeFrom(mrpt::serialization::CArchive& in,
 			TGroundAwareOptions o;
 			gam::maps::ini::read(o, in, "CGroundAwareOccupancyGrid");
 			setGroundOptions(o);
-			m_missingLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
+			resetRunState();
 			if (version >= 1) in >> m_missingLayer;
 			syncMissingLayer();
-			m_scanOnlyLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
-			m_positiveSeen.clear();
-			m_scansBeforeDepth = 0;
-			m_warnedNoFreeSpace = false;
 			// A map saved before v2 was made by this class's walker rule as it
 			// then was (always on): it counts as having seen depth frames.
 			m_depthFrames = 1;

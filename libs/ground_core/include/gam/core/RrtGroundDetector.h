@@ -267,6 +267,8 @@ class RrtGroundDetector
 	 * RMS, re-seeding, min_nodes, RANSAC's tilt limit and refit, the
 	 * collinear-nodes rule). */
 	bool paper() const { return m_params.variant == MethodVariant::Paper; }
+	/** Nodes a tree needs: min_nodes, or the 3 of a plane in the paper's variant. */
+	size_t minNodes() const { return paper() ? 3 : m_params.min_nodes; }
 	/** The child `parent` (index parentIdx) would get at cell (cx, cy): the
 	 * cell's height within E_th of the parent's local plane there, its own
 	 * local fit planarEnough(). False if a test fails (`child` undefined). */

@@ -85,6 +85,11 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		};
 		static constexpr const char* kScanRuleNames[] = {"false", "true", "auto", nullptr};
 		ScanRule scan_keeps_3d_obstacles = ScanRule::Auto;
+		/** > 0: a positive obstacle (something sticking out of the floor, or a
+		 * 2D scan's hit) not re-observed as an obstacle for this many seconds
+		 * returns to unknown -- people who left. Never a negative obstacle
+		 * (hole, drop) or missing floor: those cannot walk away. 0 = off (the
+		 * default, as STVL's voxel_decay): obstacles stay until seen free. [s] */
 		double obstacle_decay_s = 0;
 		/** The online check of the declared sensor mount (height, pitch, roll)
 		 * against every frame's floor, and the option to map with the measured one. */
@@ -238,6 +243,10 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	uint64_t m_depthFrames = 0;
 	uint64_t m_scansBeforeDepth = 0;
 	bool m_warnedNoFreeSpace = false;
+	/** The state of a run, for a grid whose cells came from elsewhere (clear,
+	 * a stock grid, deserialization): layers unknown at this grid's extent,
+	 * no obstacle ages, no depth frame received. (The mount check stays: it is
+	 * the camera's, not the map's.) */
 	void resetRunState();
 };
 
