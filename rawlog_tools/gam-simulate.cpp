@@ -1,9 +1,9 @@
 // Ground-aware mapping for MRPT -- gam-simulate: renders a scene file into an
-// observations-only rawlog (odometry + Kinect One depth + Leddar IS16) and
+// observations-only rawlog (odometry + depth camera(s) + Leddar IS16) and
 // writes the ground-truth grid. See config/scenes/README.md.
 //
 // usage: gam-simulate --scene FILE.scene --out PREFIX [--seed N] [--no-noise]
-//                     [--frames N] [--no-leddar] [--depth-images]
+//                     [--frames N] [--no-leddar] [--depth-images] [--camera MODEL]
 // outputs: PREFIX.rawlog, PREFIX_gt.pgm, PREFIX_gt.yaml, PREFIX_gt_objects.csv,
 //          PREFIX_gt_labels.csv, PREFIX_gt_path.csv, PREFIX_gt_sensors.csv and, for
 //          scenes with motion or with --gt-frames, PREFIX_gt_frames.csv (per frame)
@@ -270,6 +270,11 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<int> argFrames("", "frames", "keep only the first N frames", false, 0, "N", cmd);
 		TCLAP::SwitchArg argNoNoise("", "no-noise", "exact sensors and odometry", cmd);
 		TCLAP::SwitchArg argNoLeddar("", "no-leddar", "do not simulate the Leddar", cmd);
+		TCLAP::ValueArg<std::string> argCamera(
+			"", "camera",
+			"every depth camera of the scene becomes this model: kinect_one, d435, d455, femto, astra (the "
+			"scene's model= and its other kinect keys otherwise; see doc/simulator.md)",
+			false, "", "MODEL", cmd);
 		TCLAP::ValueArg<std::string> argMount(
 			"", "mount",
 			"the Kinect's true height, pitch and roll on the robot: z,pitch,roll [m, deg] (x, y, yaw stay the "
@@ -299,6 +304,17 @@ int main(int argc, char** argv)
 		{
 			std::cerr << "gam-simulate: error: " << e.what() << std::endl;
 			return 2;
+		}
+		if (!argCamera.getValue().empty())
+		{
+			CameraModel model;
+			if (!parseCameraModel(argCamera.getValue(), model))
+			{
+				std::cerr << "gam-simulate: error: --camera: unknown model '" << argCamera.getValue()
+						  << "' (known: " << cameraModelNames() << ")" << std::endl;
+				return 2;
+			}
+			setCameraModel(sf, model);
 		}
 		const std::string prefix = argOut.getValue();
 		const bool noise = !argNoNoise.getValue();

@@ -122,6 +122,39 @@ ConvexSolid localBox(const Pose3& f, const Eigen::Vector3d& lo, const Eigen::Vec
 	return ConvexSolid::box(c, 0.5 * (hi - lo), id);
 }
 
+}  // namespace
+
+void applyCameraKeys(KinectParams& k, const std::map<std::string, double>& keys)
+{
+	auto set = [&](const char* key, double& v) {
+		if (auto it = keys.find(key); it != keys.end()) v = it->second;
+	};
+	set("noise_scale", k.noise_scale);
+	set("min_range", k.min_range);
+	set("max_range", k.max_range);
+	set("spike_prob", k.spike_prob);
+	set("flying_prob", k.flying_prob);
+	set("grazing_start", k.grazing_start_deg);
+	set("grazing_end", k.grazing_end_deg);
+}
+
+void setCameraModel(SceneFile& sf, CameraModel model)
+{
+	const bool noise = sf.kinect.noise;
+	sf.kinect = cameraPreset(model);
+	applyCameraKeys(sf.kinect, sf.kinect_keys);
+	sf.kinect.noise = noise;
+	for (ExtraKinect& e : sf.more_kinects)
+	{
+		const bool n = e.params.noise;
+		e.params = cameraPreset(model);
+		applyCameraKeys(e.params, e.keys);
+		e.params.noise = n;
+	}
+}
+
+namespace
+{
 /** What the statements build, line after line. */
 struct SceneBuilder
 {
@@ -243,17 +276,21 @@ void parseKinect(SceneBuilder& b, Args& a)
 	Pose3& pose = first ? sf.kinect_pose : extra.pose;
 	pose = poseOf(a.list("pose", 6));
 	auto& k = first ? sf.kinect : extra.params;
-	k.noise_scale = a.num("noise_scale", k.noise_scale);
+	auto& keys = first ? sf.kinect_keys : extra.keys;
+	CameraModel model = CameraModel::KinectOne;
+	const std::string modelName = a.str("model", "kinect_one");
+	if (!parseCameraModel(modelName, model))
+		a.fail("unknown model '" + modelName + "' (known: " + cameraModelNames() + ")");
+	for (const char* key :
+		 {"noise_scale", "min_range", "max_range", "spike_prob", "flying_prob", "grazing_start", "grazing_end"})
+		if (a.has(key)) keys[key] = a.num(key, 0);
+	k = cameraPreset(model);
+	applyCameraKeys(k, keys);
 	if (k.noise_scale < 0) a.fail("noise_scale must be >= 0");
-	k.min_range = a.pos("min_range", k.min_range);
-	k.max_range = a.pos("max_range", k.max_range);
+	if (!(k.min_range > 0) || !(k.max_range > 0)) a.fail("min_range and max_range must be > 0");
 	if (k.max_range <= k.min_range) a.fail("max_range must be > min_range");
-	k.spike_prob = a.num("spike_prob", k.spike_prob);
-	k.flying_prob = a.num("flying_prob", k.flying_prob);
 	if (k.spike_prob < 0 || k.spike_prob > 1 || k.flying_prob < 0 || k.flying_prob > 1)
 		a.fail("probabilities must be in [0,1]");
-	k.grazing_start_deg = a.num("grazing_start", k.grazing_start_deg);
-	k.grazing_end_deg = a.num("grazing_end", k.grazing_end_deg);
 	if (!(k.grazing_end_deg > k.grazing_start_deg)) a.fail("grazing_end must be > grazing_start");
 	double& sway = first ? sf.kinect_sway : extra.sway;
 	sway = a.num("sway", 0) * kDeg;

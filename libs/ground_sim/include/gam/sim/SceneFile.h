@@ -13,7 +13,8 @@
 //   floor present=1                      # present=0: no floor at all
 //   kinect pose=x,y,z,yaw,pitch,roll     # on the robot; pitch>0 looks down
 //          [label=KINECT]   # several kinect statements = several cameras, unique labels
-//          [noise_scale=1] [min_range=0.5] [max_range=4.5] [spike_prob=1e-4]
+//          [model=kinect_one|d435|d455|femto|astra]  # the camera's preset (Sensors.h)
+//          [noise_scale=1] [min_range=0.5] [max_range=4.5] [spike_prob=1e-4]  # override the preset
 //          [flying_prob=0.5] [grazing_start=70] [grazing_end=85] [sway=0]
 //        # sway: sigma [deg] of a random pitch and roll of the real sensor per
 //        # frame (walker rocking), NOT reflected in the rawlog's sensorPose
@@ -49,6 +50,7 @@
 #pragma once
 
 #include <istream>
+#include <map>
 #include <stdexcept>
 #include <string>
 
@@ -70,6 +72,7 @@ struct ExtraKinect
 {
 	std::string label;
 	KinectParams params;
+	std::map<std::string, double> keys;  ///< the statement's settings beside model= (kept by setCameraModel)
 	Pose3 pose;
 	double sway = 0;
 };
@@ -78,6 +81,7 @@ struct SceneFile
 {
 	Scene scene;
 	KinectParams kinect;
+	std::map<std::string, double> kinect_keys;  ///< the statement's settings beside model=
 	Pose3 kinect_pose = Pose3::fromXYZYPR(0.10, 0, 1.0, 0, 25 * M_PI / 180, 0);
 	LeddarParams leddar;
 	Pose3 leddar_pose = Pose3::fromXYZYPR(0.20, 0, 0.30, 0, 0, 0);
@@ -93,6 +97,13 @@ struct SceneFile
 	GridSpec grid;
 	bool has_grid = false;
 };
+
+/** Sets a camera's settings from a `kinect` statement's keys (noise_scale,
+ * min_range, max_range, spike_prob, flying_prob, grazing_start, grazing_end). */
+void applyCameraKeys(KinectParams& k, const std::map<std::string, double>& keys);
+/** Every camera of the scene becomes `model` (its preset), keeping the keys
+ * its statement set and the noise switch (gam-simulate --camera). */
+void setCameraModel(SceneFile& sf, CameraModel model);
 
 /** Parses a scene; `filename` is used in the error messages only. */
 SceneFile parseScene(std::istream& in, const std::string& filename);

@@ -46,14 +46,29 @@
 #pragma once
 
 #include <random>
+#include <string>
 #include <vector>
 
 #include "gam/sim/Scene.h"
 
 namespace gam::sim
 {
+/** The depth cameras the simulator models (see the presets in
+ * cameraPreset() and doc/simulator.md for the makers' figures). */
+enum class CameraModel
+{
+	KinectOne,  ///< time of flight, 512x424 (the default)
+	D435,       ///< Intel RealSense D435, active stereo, 848x480
+	D455,       ///< Intel RealSense D455, active stereo, 848x480
+	Femto,      ///< Orbbec Femto Bolt / Azure Kinect, time of flight, 640x576 narrow mode
+	Astra       ///< Orbbec Astra, structured light, 640x480
+};
+
+/** Parameters of one simulated depth camera. The defaults are the Kinect One;
+ * cameraPreset() gives the other models. */
 struct KinectParams
 {
+	CameraModel model = CameraModel::KinectOne;
 	int width = 512, height = 424;
 	double hfov_deg = 70.6, vfov_deg = 60.0;
 	double min_range = 0.5, max_range = 4.5;
@@ -64,15 +79,46 @@ struct KinectParams
 	double flying_jump_abs = 0.05, flying_jump_rel = 0.04;
 	double spike_prob = 1e-4;
 
+	// --- depth from disparity (active stereo, structured light): baseline > 0 ---
+	/** Stereo baseline (projector-camera for structured light) [m]; 0 = time of flight. */
+	double baseline = 0;
+	double disp_sigma_px = 0;       ///< per-pixel disparity noise, sigma [px]
+	double disp_corr_sigma_px = 0;  ///< spatially correlated disparity noise, rms [px]
+	int disp_corr_px = 16;          ///< its correlation length (lattice spacing) [px]
+	double disp_step_px = 0;        ///< disparity quantisation step [px] (0 = none)
+	int fatten_px = 0;              ///< edges fattened toward the background by up to this [px]
+	double fatten_prob = 0.7;       ///< probability that a background pixel that close takes the foreground's depth
+	// --- time of flight: multipath in concave corners ---
+	/** Extra range [m] of a floor pixel at the foot of a wall (and of a wall pixel
+	 * at floor level); decays as exp(-s / multipath_decay) with the distance s to the corner. */
+	double multipath_m = 0, multipath_decay = 0.3;
+
+	bool fromDisparity() const { return baseline > 0; }
+
 	double fx() const;
 	double fy() const;
 	double cx() const { return 0.5 * (width - 1); }
 	double cy() const { return 0.5 * (height - 1); }
-	/** The documented axial sigma [m] for depth z [m] and incidence theta [rad]. */
+	/** The documented axial sigma [m] for depth z [m] and incidence theta [rad]:
+	 * time of flight, the Kinect v2 model above (times noise_scale); from
+	 * disparity, z^2 * sigma_d / (fx * baseline) with sigma_d the rms of the
+	 * per-pixel and correlated disparity noise (no incidence term; quantisation
+	 * not included). */
 	double sigma(double z, double theta) const;
+	/** Disparity [px] of depth z [m] (fx * baseline / z); 0 for time of flight. */
+	double disparity(double z) const { return fromDisparity() ? fx() * baseline / z : 0.0; }
 	/** Probability of a grazing dropout for incidence theta [rad]. */
 	double dropoutProb(double theta) const;
 };
+
+/** The preset of a camera model (its resolution, field of view, range and noise). */
+KinectParams cameraPreset(CameraModel model);
+/** "kinect_one", "d435", "d455", "femto", "astra". */
+const char* cameraModelName(CameraModel model);
+/** The model of a name cameraModelName() gives; false for an unknown name. */
+bool parseCameraModel(const std::string& name, CameraModel& model);
+/** The names, comma separated (for error messages). */
+std::string cameraModelNames();
 
 /** Per-pixel flags of a simulated depth frame. */
 enum PixelFlag : uint8_t
@@ -82,7 +128,9 @@ enum PixelFlag : uint8_t
 	PixFlying = 4,   ///< mixed depth at an edge
 	PixSpike = 8,
 	PixOutOfRange = 16,  ///< no surface in [min_range, max_range]
-	PixEdge = 32         ///< lies on a true depth discontinuity
+	PixEdge = 32,        ///< lies on a true depth discontinuity
+	PixOccluded = 64,    ///< stereo: not seen by the second imager (or projector)
+	PixFattened = 128    ///< stereo: took the depth of a nearer surface beside it
 };
 
 struct DepthFrame
@@ -110,6 +158,13 @@ class KinectModel
 	DepthFrame render(const Scene& scene, const Pose3& sensorInWorld, std::mt19937& rng) const;
 	/** Unit-less ray (x = 1) of pixel (r, c) in the sensor frame. */
 	Eigen::Vector3d pixelRay(int r, int c) const;
+
+   private:
+	/** Extra depth [m] per pixel from multipath in concave corners (ToF). */
+	std::vector<float> multipathBias(
+		const Pose3& sensorInWorld, const DepthFrame& f, const std::vector<float>& normalZ) const;
+	/** Steps 3-4 for a camera with depth from disparity. */
+	void renderDisparityNoise(const Scene& scene, DepthFrame& f, std::mt19937& rng) const;
 };
 
 struct LeddarParams
