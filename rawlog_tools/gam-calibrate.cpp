@@ -9,6 +9,9 @@
 //   CAM z=<m> pitch=<deg> roll=<deg> (+-<m>, +-<deg>, +-<deg>) frames=<used>/<total>
 // (the +- are the standard errors of the means over the frames used), then
 // the declared sensorPose for comparison. MRPT's yaw/pitch/roll convention.
+// The declared pose is a rough guess: each frame is first searched for the
+// floor within height +- 0.3 m, pitch +- 20 deg, roll +- 10 deg of it
+// (gam::searchFloor), and that floor places the points for the map's plane.
 // x, y and yaw are not observable from a floor: --write-ini keeps the
 // declared ones and writes `CAM = x y z yaw pitch roll` into the file's
 // [sensor_poses] section, which ground-aware-mapper applies to the
@@ -30,6 +33,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -67,8 +71,33 @@ struct Camera
 {
 	std::vector<gam::SensorMount> perFrame;
 	size_t frames = 0;
+	size_t searched = 0;                           ///< frames whose floor the search found near the declared mount
+	std::vector<gam::SensorMount> searchedMounts;  ///< what the search found (before the map's plane)
+	size_t mapPlaneOverruled = 0;                  ///< frames where the map's plane left the search's
 	mrpt::poses::CPose3D declared;
 };
+
+/** Sensor-frame points of a depth frame, every `step`-th pixel of every
+ * `step`-th row (ray (1, (cx - c) / fx, (cy - r) / fy) times the depth;
+ * MRPT's convention), zero and out-of-range pixels skipped. */
+std::vector<Eigen::Vector3d> sensorPoints(const mrpt::obs::CObservation3DRangeScan& o, int step)
+{
+	std::vector<Eigen::Vector3d> pts;
+	if (!o.hasRangeImage || !o.range_is_depth) return pts;
+	const auto& cp = o.cameraParams;
+	const double fx = cp.fx(), fy = cp.fy(), cx = cp.cx(), cy = cp.cy();
+	if (!(fx > 0) || !(fy > 0)) return pts;
+	const int rows = int(o.rangeImage.rows()), cols = int(o.rangeImage.cols());
+	const double maxR = o.maxRange > 0 ? o.maxRange : 1e9;
+	for (int r = 0; r < rows; r += step)
+		for (int c = 0; c < cols; c += step)
+		{
+			const double d = o.rangeImage(r, c) * double(o.rangeUnits);
+			if (!(d > 0) || d > maxR) continue;
+			pts.emplace_back(d, (cx - c) / fx * d, (cy - r) / fy * d);
+		}
+	return pts;
+}
 
 /** Writes `label = x y z yaw pitch roll` into [sensor_poses] of `path`,
  * keeping the rest of the file (created if missing). */
@@ -182,12 +211,48 @@ int main(int argc, char** argv)
 			Camera& cam = cams[label];
 			cam.frames++;
 			fr.obs->getSensorPose(cam.declared);
+			// Search the frame for the floor near the declared mount first: a
+			// rough guess (height +- 0.3 m, pitch +- 20 deg, roll +- 10 deg) tilts
+			// the floor too much for the map's own plane detection. The plane
+			// found places the points; the map's plane then refines it. The
+			// result does not depend on the guess (calibrating again from it
+			// gives the same answer): the search's points and seed are the frame's.
+			std::optional<gam::SensorMount> searched;
+			{
+				const mrpt::poses::CPose3D& dp = cam.declared;
+				const auto floor = gam::searchFloor(
+					sensorPoints(*o3, 4), gam::SensorMount{dp.z(), dp.pitch(), dp.roll()}, gam::FloorSearchParams{},
+					unsigned(cam.frames));
+				if (const auto m = floor ? gam::mountFromFloor(*floor) : std::nullopt)
+				{
+					fr.obs->setSensorPose(mrpt::poses::CPose3D(dp.x(), dp.y(), m->height, dp.yaw(), m->pitch, m->roll));
+					cam.searched++;
+					cam.searchedMounts.push_back(*m);
+					searched = m;
+				}
+			}
 			const size_t before =
 				g->second.mountChecks().count(label) ? g->second.mountChecks().at(label).status().frames_checked : 0;
 			// A fresh grid per frame would also do: only the plane of this frame counts.
 			g->second.insertObservation(*fr.obs, fr.robotPose);
 			const gam::MountStatus& s = g->second.mountChecks().at(label).status();
-			if (s.frames_checked > before) cam.perFrame.push_back(s.last);
+			if (s.frames_checked > before)
+			{
+				// The map's plane refines the search's, unless it left it by more
+				// than the mount check's tolerances: a plane fitted to a far floor
+				// by a noisy camera (a RealSense seeing the floor only 2-5 m
+				// ahead: 14 cm off under the robot) is worse than the image-wide
+				// floor fit, which then stands.
+				const auto& mp = g->second.groundOptions().mount;
+				const bool agrees =
+					!searched || (std::abs(s.last.height - searched->height) <= mp.tolerance_z &&
+								  std::abs(s.last.pitch - searched->pitch) <= mp.tolerance_deg * M_PI / 180 &&
+								  std::abs(s.last.roll - searched->roll) <= mp.tolerance_deg * M_PI / 180);
+				cam.perFrame.push_back(agrees ? s.last : *searched);
+				cam.mapPlaneOverruled += !agrees;
+			}
+			else if (searched)
+				cam.perFrame.push_back(*searched);
 			if (++n % 50 == 0) std::cerr << "gam-calibrate: " << n << " depth frames\n";
 		}
 		if (cams.empty())
@@ -213,9 +278,18 @@ int main(int argc, char** argv)
 				e.standard_error.roll * k, e.used, cam.frames);
 			std::printf(
 				"  declared sensorPose: z=%.4f pitch=%.3f roll=%.3f (x=%.4f y=%.4f yaw=%.3f kept: not observable from "
-				"the floor); %zu frames had a floor plane, %zu rejected\n",
+				"the floor); floor found by the search in %zu frames; %zu frames had a floor plane, %zu rejected\n",
 				cam.declared.z(), cam.declared.pitch() * k, cam.declared.roll() * k, cam.declared.x(), cam.declared.y(),
-				cam.declared.yaw() * k, cam.perFrame.size(), cam.perFrame.size() - e.used);
+				cam.declared.yaw() * k, cam.searched, cam.perFrame.size(), cam.perFrame.size() - e.used);
+			if (!cam.searchedMounts.empty())
+			{
+				const gam::MountEstimate se = gam::estimateMount(cam.searchedMounts);
+				std::printf(
+					"  the search alone (floor RANSAC in the image, before the map's plane): z=%.4f pitch=%.3f "
+					"roll=%.3f; the map's plane left it beyond the mount tolerances in %zu frames (the search's "
+					"kept there)\n",
+					se.mean.height, se.mean.pitch * k, se.mean.roll * k, cam.mapPlaneOverruled);
+			}
 			if (!argWrite.getValue().empty())
 			{
 				const mrpt::poses::CPose3D p(

@@ -185,3 +185,65 @@ TEST(SensorMount, RobustEstimateRejectsFramesThatDisagree)
 	// No frames: nothing.
 	EXPECT_EQ(estimateMount({}).used, 0u);
 }
+
+namespace
+{
+/** Sensor-frame points of a 64x48 camera (fx = fy = 50) mounted `height` above
+ * the floor, pitched and rolled, looking at the floor, a table top 0.75 m high
+ * (x 1.2..1.8, y -0.6..0.6 in the robot frame) and a wall at x = 4 m. */
+std::vector<Eigen::Vector3d> floorTableWall(double height, double pitch, double roll)
+{
+	const Eigen::Matrix3d R =
+		(Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+			.toRotationMatrix();
+	const Eigen::Vector3d t(0, 0, height);
+	std::vector<Eigen::Vector3d> pts;
+	for (int r = 0; r < 48; r++)
+		for (int c = 0; c < 64; c++)
+		{
+			const Eigen::Vector3d ray(1.0, (31.5 - c) / 50.0, (23.5 - r) / 50.0);
+			const Eigen::Vector3d w = R * ray;
+			double best = std::numeric_limits<double>::infinity();
+			if (w.z() < 0) best = -t.z() / w.z();  // floor
+			if (w.z() < 0)
+			{
+				const double tt = (0.75 - t.z()) / w.z();  // table top, from above
+				const Eigen::Vector3d q = t + tt * w;
+				if (tt > 0 && q.x() > 1.2 && q.x() < 1.8 && std::abs(q.y()) < 0.6) best = std::min(best, tt);
+			}
+			if (w.x() > 0) best = std::min(best, (4.0 - t.x()) / w.x());  // wall
+			if (std::isfinite(best) && best < 6) pts.push_back(best * ray);
+		}
+	return pts;
+}
+}  // namespace
+
+TEST(SensorMount, FloorSearchFromARoughGuess)
+{
+	// The camera is 0.90 m up, pitched 31 deg, rolled 3 deg; the guess says 1.0 m,
+	// 20 deg, 0 deg (0.1 m, 11 deg and 3 deg off: inside 0.3 m / 20 deg / 10 deg).
+	// The table top is 0.15 m below the camera (0.75 m off the guess: rejected), the
+	// wall 90 deg off: the floor is found. The points are exact; the wall's foot
+	// (points within the last, quarter band of the floor) may pull the fit by a
+	// little, far within the 1 cm / 0.5 deg asked of a calibration.
+	const auto pts = floorTableWall(0.90, deg2rad(31), deg2rad(3));
+	size_t inliers = 0;
+	const auto floor = searchFloor(pts, SensorMount{1.0, deg2rad(20), 0.0}, FloorSearchParams{}, 1, &inliers);
+	ASSERT_TRUE(floor);
+	const auto m = mountFromFloor(*floor);
+	ASSERT_TRUE(m);
+	EXPECT_NEAR(m->height, 0.90, 0.002);
+	EXPECT_NEAR(rad2deg(m->pitch), 31.0, 0.1);
+	EXPECT_NEAR(rad2deg(m->roll), 3.0, 0.1);
+	EXPECT_GT(inliers, 500u);
+	// Calibrating again from the answer finds the same plane.
+	const auto again = searchFloor(pts, *m, FloorSearchParams{}, 1);
+	ASSERT_TRUE(again);
+	EXPECT_NEAR(again->d, floor->d, 1e-9);
+	EXPECT_NEAR(again->normal.dot(floor->normal), 1.0, 1e-12);
+	// A guess 25 deg off in pitch is outside the search: no floor (the wall and
+	// the table are rejected too).
+	EXPECT_FALSE(searchFloor(pts, SensorMount{0.9, deg2rad(56), 0.0}, FloorSearchParams{}, 1));
+	// Too few points: nothing.
+	EXPECT_FALSE(searchFloor({pts.begin(), pts.begin() + 100}, *m, FloorSearchParams{}, 1));
+}

@@ -5,11 +5,15 @@
 // does with a depth bag (config/rosbag2rawlog-depth.yml).
 #include <gtest/gtest.h>
 #include <mrpt/img/CImage.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CRawlog.h>
+#include <mrpt/serialization/CArchive.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -17,6 +21,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -643,3 +648,161 @@ TEST(Rosbag2Rawlog, WhatDebianRosbag2rawlogDoesWithADepthBag)
 	EXPECT_NE(m.out.find("frames: 3 (3 3D scans"), std::string::npos) << m.out;
 #endif
 }
+
+#if defined(GAM_MAPPER_EXE) && defined(GAM_CALIBRATE_EXE)
+namespace
+{
+/** "key,value" of the RealSense Viewer's metadata csv. */
+double metadataValue(const std::string& csv, const std::string& key)
+{
+	std::istringstream in(csv);
+	std::string line;
+	while (std::getline(in, line))
+		if (line.rfind(key + ",", 0) == 0) return std::stod(line.substr(key.size() + 1));
+	ADD_FAILURE() << "no " << key << " in the metadata";
+	return 0;
+}
+/** z, pitch, roll of gam-calibrate's first line "LABEL z=.. pitch=.. roll=.. ...". */
+bool parseCalibration(const std::string& out, double& z, double& pitch, double& roll)
+{
+	const auto at = out.find(" z=");
+	return at != std::string::npos &&
+		   std::sscanf(out.c_str() + at, " z=%lf pitch=%lf roll=%lf", &z, &pitch, &roll) == 3;
+}
+}  // namespace
+
+TEST(GamImportRealRealSense, EaselFrameFromARoughGuessToAMap)
+{
+	// The real D400 frame (848x480, the floor 2-5 m ahead, an easel's legs; see
+	// ../shared/data/real/realsense_d400_basement_easel/README.md), imported with the
+	// viewer's intrinsics and a rough mount (1.0 m high, pitched 10 deg down: the camera
+	// is about 0.76 m up and level), calibrated from that guess, re-calibrated from the
+	// answer, then mapped.
+	const std::string dir = realData("realsense_d400_basement_easel");
+	if (!fs::exists(dir + "/001_big_depth_z16.png")) GTEST_SKIP() << "no " << dir;
+	const std::string meta = readAll(dir + "/001_big_depth_metadata.csv");
+	const std::string d = tmpDir("realsense");
+	fs::create_directories(d + "/png");
+	fs::copy_file(dir + "/001_big_depth_z16.png", d + "/png/001.png", fs::copy_options::overwrite_existing);
+	char intr[300];
+	std::snprintf(
+		intr, sizeof intr, "'%d %d %.9g %.9g %.9g %.9g'", int(metadataValue(meta, "Resolution x")),
+		int(metadataValue(meta, "Resolution y")), metadataValue(meta, "Fx"), metadataValue(meta, "Fy"),
+		metadataValue(meta, "PPx"), metadataValue(meta, "PPy"));
+	ProcessResult r = import(
+		"png -i " + d + "/png -o " + d + "/rs.rawlog --intrinsics " + intr +
+		" --sensor-pose '0 0 1.0 0 10 0' --label REALSENSE_D400");
+	ASSERT_EQ(r.rc, 0) << r.err;
+
+	const std::string ini = d + "/rs.ini";
+	fs::copy_file(
+		std::string(GAM_SOURCE_DIR) + "/config/ground-aware-mapper.ini", ini, fs::copy_options::overwrite_existing);
+	const std::string cal = std::string(GAM_CALIBRATE_EXE) + " --rawlog " + d + "/rs.rawlog --config " + ini;
+	r = run(cal + " --write-ini " + ini);
+	ASSERT_EQ(r.rc, 0) << r.out << r.err;
+	double z = 0, pitch = 0, roll = 0;
+	ASSERT_TRUE(parseCalibration(r.out, z, pitch, roll)) << r.out;
+	// The dataset's own floor fit (RANSAC on the lower half, 2 cm inliers): 0.76 m,
+	// pitch -1.3 deg, roll 0.4 deg, "an estimate, not ground truth": within a few cm.
+	EXPECT_NEAR(z, 0.76, 0.04) << r.out;
+	EXPECT_NEAR(pitch, -1.3, 1.5) << r.out;
+	EXPECT_NEAR(roll, 0.4, 1.0) << r.out;
+	// Calibrating again from the answer gives the same answer.
+	const ProcessResult again = run(cal);
+	ASSERT_EQ(again.rc, 0) << again.err;
+	double z2 = 0, pitch2 = 0, roll2 = 0;
+	ASSERT_TRUE(parseCalibration(again.out, z2, pitch2, roll2)) << again.out;
+	EXPECT_NEAR(z2, z, 1e-4);
+	EXPECT_NEAR(pitch2, pitch, 1e-3);
+	EXPECT_NEAR(roll2, roll, 1e-3);
+
+	// The frame's own points, placed with the calibrated mount: a floor cell has >= 5
+	// points, all within 3 cm of z = 0 (this test's reading of the data, not the map's);
+	// an object cell has >= 5 points 0.15-1.2 m up and none within 3 cm of the floor,
+	// 1.5-3.5 m ahead (the easel's legs and what stands near it).
+	auto obs = firstScan(d + "/rs.rawlog");
+	ASSERT_TRUE(obs);
+	obs->setSensorPose(mrpt::poses::CPose3D(0, 0, z, 0, mrpt::DEG2RAD(pitch), mrpt::DEG2RAD(roll)));
+	mrpt::maps::CSimplePointsMap pts;
+	mrpt::obs::T3DPointsProjectionParams pp;
+	pp.takeIntoAccountSensorPoseOnRobot = true;
+	obs->unprojectInto(pts, pp);
+	struct Score
+	{
+		size_t floorKnown = 0, floorOcc = 0, objects = 0, objectsOcc = 0;
+	};
+	// The map of the calibrated .ini with `key=value` set in its ground-aware section.
+	auto score = [&](const std::string& key, const std::string& value) {
+		Score sc;
+		std::string text = readAll(ini);
+		if (!key.empty())
+		{
+			const auto at = text.find("\n" + key + "=");
+			EXPECT_NE(at, std::string::npos) << key;
+			if (at == std::string::npos) return sc;
+			const auto eol = text.find_first_of(" \t;\n", at + key.size() + 2);
+			text.replace(at + key.size() + 2, eol - (at + key.size() + 2), value);
+		}
+		const std::string variant = d + "/variant.ini", out = d + "/maps_" + (key.empty() ? "default" : key);
+		writeText(variant, text);
+		const ProcessResult m =
+			run(std::string(GAM_MAPPER_EXE) + " -q -r " + d + "/rs.rawlog -c " + variant + " -o " + out);
+		EXPECT_EQ(m.rc, 0) << m.err;
+		mrpt::maps::COccupancyGridMap2D grid;  // the mapper writes the stock class
+		mrpt::io::CFileGZInputStream f(out + "/ground_aware.gridmap.gz");
+		auto a = mrpt::serialization::archiveFrom(f);
+		a >> grid;
+		struct CellStats
+		{
+			int n = 0, nFloor = 0, nHigh = 0;
+		};
+		std::map<std::pair<int, int>, CellStats> cells;
+		for (size_t i = 0; i < pts.size(); i++)
+		{
+			float x, y, pz;
+			pts.getPoint(i, x, y, pz);
+			if (std::hypot(x, y) > 5.0) continue;  // the map's max_range
+			auto& c = cells[{grid.x2idx(x), grid.y2idx(y)}];
+			c.n++;
+			c.nFloor += std::abs(pz) <= 0.03f;
+			c.nHigh += pz >= 0.15f && pz <= 1.2f;
+		}
+		for (const auto& [k, c] : cells)
+		{
+			const float pOcc = 1.0f - grid.getCell(unsigned(k.first), unsigned(k.second));
+			const double x = grid.idx2x(unsigned(k.first)), y = grid.idx2y(unsigned(k.second));
+			if (std::abs(pOcc - 0.5f) < 1e-3f) continue;  // no evidence (beyond the range of trust)
+			if (c.n >= 5 && c.nFloor == c.n)
+			{
+				sc.floorKnown++;
+				sc.floorOcc += pOcc > 0.5f;
+			}
+			else if (c.nHigh >= 5 && c.nFloor == 0 && x > 1.5 && x < 3.5 && std::abs(y) < 1.5)
+			{
+				sc.objects++;
+				sc.objectsOcc += pOcc > 0.5f;
+			}
+		}
+		std::printf(
+			"[ RealSense ] %s: floor cells the map knows %zu, %zu occupied; object cells 1.5-3.5 m ahead %zu, %zu "
+			"occupied\n",
+			key.empty() ? "default" : (key + "=" + value).c_str(), sc.floorKnown, sc.floorOcc, sc.objects,
+			sc.objectsOcc);
+		return sc;
+	};
+	std::printf("[ RealSense ] calibrated z=%.3f pitch=%.2f roll=%.2f\n", z, pitch, roll);
+	const Score def = score("", "");
+	ASSERT_GT(def.floorKnown, 100u);
+	EXPECT_LE(double(def.floorOcc), 0.01 * double(def.floorKnown));  // the issue's "<= 1 % occupied"
+	ASSERT_GT(def.objects, 3u);
+	EXPECT_GE(double(def.objectsOcc), 0.9 * double(def.objects));
+	// The rules of issue #27 on this frame (their measured effect, printed).
+	// Without max_ground_offset the tree's plane, fitted to the floor 2-3 m ahead and
+	// tilted by the stereo noise there (0.65 m, -3.3 deg against the 0.79 m, -0.3 deg of
+	// the image-wide fit), puts most of the floor above the ground band.
+	const Score noOffset = score("max_ground_offset", "0");
+	EXPECT_GT(noOffset.floorOcc, noOffset.floorKnown / 2);
+	score("range_of_trust", "false");
+	score("camera_model", "kinect_one");
+}
+#endif

@@ -74,6 +74,8 @@ void GroundAwarePipeline::resetResult()
 	m_result.detection.clear();
 	m_result.ism = IsmStats{};
 	m_result.missing = MissingFloorStats{};
+	m_result.camera = CameraModel::Custom;
+	m_result.trust_range = std::numeric_limits<double>::infinity();
 	m_missing.clear();
 	m_result.ms = StageTimes{};
 }
@@ -125,11 +127,38 @@ const FrameResult& GroundAwarePipeline::process(
 	hint.y = robot.y();
 	hint.floor_z = robot.z();
 	m_rrt.detect(m_grid, hint, m_result.detection);
+	GroundDetection& det = m_result.detection;
+	if (m_params.max_ground_offset > 0 && m_params.rrt.variant != MethodVariant::Paper && det.ok() &&
+		std::abs(det.plane().heightAt(robot.x(), robot.y()) - robot.z()) > m_params.max_ground_offset)
+	{
+		// Not the floor the robot stands on: judge the frame against that floor.
+		det.tree_plane = det.planes[0];
+		det.planes[0] = Plane{0, 0, 1, -robot.z()};
+		det.ground_from_mount = true;
+	}
 	const auto t3 = clk::now();
 
-	// 3. Evidence.
+	// 3. Evidence, within the range of trust of the camera.
 	m_result.sensor = frame.sensor_position;
-	m_ism.compute(m_grid, m_result.detection, m_result.sensor, m_params.projection.max_range, m_result.ism, &m_bins);
+	double evidenceRange = m_params.projection.max_range;
+	if (m_params.ism.model != MethodVariant::Paper)
+	{
+		const CameraParams& cam = m_params.camera;
+		m_result.camera = cam.model != CameraModel::Auto ? cam.model
+														 : detectCameraModel(
+															   frame.sensor_label, frame.intrinsics.width,
+															   frame.intrinsics.height, frame.intrinsics.fx);
+		if (cam.range_of_trust && frame.has_image)
+		{
+			const CameraNoise noise =
+				m_result.camera == CameraModel::Custom ? cam.custom : cameraNoisePreset(m_result.camera);
+			m_result.trust_range = trustRange(
+				noise, frame.intrinsics.fx, frame.sensor_position.z() - robot.z(), lattice.resolution,
+				m_params.ism.noise_sigmas, m_params.ism.traversable_step, evidenceRange);
+			evidenceRange = std::min(evidenceRange, m_result.trust_range);
+		}
+	}
+	m_ism.compute(m_grid, m_result.detection, m_result.sensor, evidenceRange, m_result.ism, &m_bins);
 	const auto t4 = clk::now();
 
 	// 4. Missing floor: where the ground predicts a floor return and the
@@ -137,7 +166,7 @@ const FrameResult& GroundAwarePipeline::process(
 	if (m_params.missing.enabled && m_params.ism.model != MethodVariant::Paper && frame.has_image &&
 		m_result.detection.ok() && m_result.ism.applied)
 	{
-		const double range = std::min<double>(frame.max_range, m_params.projection.max_range);
+		const double range = std::min<double>(frame.max_range, evidenceRange);
 		m_missing.compute(
 			frame, m_projector, m_params.projection.decimation, range, m_result.detection.plane(), m_grid,
 			m_ism.classes(), m_result.missing);

@@ -41,6 +41,9 @@ std::string GroundDetection::describe() const
 		const Plane& p = planes.front();
 		s << "; ground " << p.a << "x + " << p.b << "y + " << p.c << "z + " << p.d << " = 0 (tilt "
 		  << p.tiltAngle() * 180.0 / M_PI << " deg)";
+		if (ground_from_mount)
+			s << ", the robot's floor: the tree's plane " << tree_plane.a << "x + " << tree_plane.b << "y + "
+			  << tree_plane.c << "z + " << tree_plane.d << " = 0 was too far from it";
 	}
 	return s.str();
 }
@@ -226,10 +229,13 @@ void RrtGroundDetector::fillPatches(const ElevationGrid& grid, const Plane& grou
 	// node is skipped. A new node passes the tree's tests against its parent
 	// (E_th, max_fit_rms, N_th); it is expanded in turn only while it is off
 	// the ground plane or tilted away from it (offGround), so the filling
-	// stops where the patch meets the floor again. At most K + 1 nodes in
-	// all: the capacity the tree has reserved.
+	// stops where the patch meets the floor again. At most K nodes more than
+	// the tree has (2K + 1 in all: the capacity reserved). The budget was K + 1
+	// in all: a wide camera (a D435's 87 deg) fills the tree's K + 1 with floor
+	// nodes and left none for the ramp (ramp_8deg_0.7m seen by a D435: 10 %
+	// of its known cells free; 81 % with a budget of its own).
 	const GridGeometry& g = grid.geometry();
-	const size_t cap = maxTreeNodes(g);  // the capacity reserved for the tree: no allocation
+	const size_t cap = std::min(maxTreeNodes(g), out.nodes.size() + size_t(m_params.iterations));
 	const int sx = m_params.neighbourhood_x, sy = m_params.neighbourhood_y, hx = sx / 2, hy = sy / 2;
 	const double off = m_params.ransac_inlier_distance;
 	// A node grows the patch if it is off the ground plane, or if its local
@@ -277,13 +283,14 @@ void RrtGroundDetector::fillPatches(const ElevationGrid& grid, const Plane& grou
 
 size_t RrtGroundDetector::maxTreeNodes(const GridGeometry& g) const
 {
-	return std::min(size_t(m_params.iterations) + 1, g.cellCount());
+	// The tree's K + 1 and fill_patches' K more.
+	return std::min(2 * size_t(m_params.iterations) + 1, g.cellCount());
 }
 
 void RrtGroundDetector::reserveScratch(const GridGeometry& g)
 {
 	// Everything detect() fills is bounded by the most nodes a tree can have
-	// (K + 1, and one per cell), s_x * s_y fit cells and max_planes: reserving
+	// (2K + 1 with fill_patches, and one per cell), s_x * s_y fit cells and max_planes: reserving
 	// that once keeps every later frame (with the same grid and parameters)
 	// free of heap allocations. No-ops when the capacity is already there.
 	const size_t maxNodes = maxTreeNodes(g);

@@ -1,6 +1,9 @@
 // Ground-aware mapping for MRPT
 #include "gam/core/SensorMount.h"
 
+#include <Eigen/Eigenvalues>
+#include <random>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -152,4 +155,83 @@ void MountMonitor::update(const SensorMount& declared, const std::optional<Senso
 	s.estimate = {median(&SensorMount::height), median(&SensorMount::pitch), median(&SensorMount::roll)};
 	s.has_estimate = m_ring.size() >= size_t(m_params.alarm_frames);
 }
+std::optional<SensorPlane> searchFloor(
+	const std::vector<Eigen::Vector3d>& pts, const SensorMount& guess, const FloorSearchParams& p, unsigned seed,
+	size_t* inliersOut)
+{
+	if (inliersOut) *inliersOut = 0;
+	const size_t n = pts.size();
+	if (n < 3 || n < p.min_inliers) return std::nullopt;
+	std::mt19937 rng(seed);
+	std::uniform_int_distribution<size_t> pick(0, n - 1);
+	auto angleDiff = [](double a, double b) { return std::abs(std::remainder(a - b, 2 * M_PI)); };
+	auto accepted = [&](const SensorPlane& pl, SensorMount& m) {
+		const auto mm = mountFromFloor(pl);
+		if (!mm) return false;
+		m = *mm;
+		return std::abs(m.height - guess.height) <= p.height_tolerance &&
+			   angleDiff(m.pitch, guess.pitch) <= p.pitch_tolerance &&
+			   angleDiff(m.roll, guess.roll) <= p.roll_tolerance;
+	};
+	double scale = 1;  // of the inlier band: the refits narrow it
+	auto isInlier = [&](const SensorPlane& pl, const Eigen::Vector3d& q) {
+		return std::abs(pl.normal.dot(q) + pl.d) <= scale * (p.inlier_distance + p.inlier_distance_per_m * q.norm());
+	};
+	SensorPlane best{};
+	size_t bestCount = 0;
+	for (int it = 0; it < p.iterations; it++)
+	{
+		const Eigen::Vector3d& a = pts[pick(rng)];
+		const Eigen::Vector3d& b = pts[pick(rng)];
+		const Eigen::Vector3d& c = pts[pick(rng)];
+		Eigen::Vector3d nrm = (b - a).cross(c - a);
+		const double len = nrm.norm();
+		if (!(len > 1e-9)) continue;
+		SensorPlane pl{nrm / len, 0};
+		pl.d = -pl.normal.dot(a);
+		SensorMount m;
+		if (!accepted(pl, m)) continue;
+		size_t count = 0;
+		for (const auto& q : pts) count += isInlier(pl, q);
+		if (count > bestCount)
+		{
+			bestCount = count;
+			best = pl;
+		}
+	}
+	if (bestCount < std::max<size_t>(3, p.min_inliers)) return std::nullopt;
+	// Refit to the inliers (total least squares) in a band halved each round:
+	// the refitted plane's inliers are the floor's, not the 3 points', and the
+	// foot of a wall or the edge of a mat no longer pulls it. A plane through
+	// a floor/wall corner (many points near both, on neither) loses its
+	// inliers here and is no floor.
+	for (int round = 0; round < 3; round++)
+	{
+		scale = round == 0 ? 1.0 : 0.5 * scale;
+		Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+		size_t k = 0;
+		for (const auto& q : pts)
+			if (isInlier(best, q))
+			{
+				mean += q;
+				k++;
+			}
+		if (k < std::max<size_t>(3, p.min_inliers)) return std::nullopt;
+		mean /= double(k);
+		Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+		for (const auto& q : pts)
+			if (isInlier(best, q)) cov += (q - mean) * (q - mean).transpose();
+		Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+		Eigen::Vector3d nrm = es.eigenvectors().col(0);
+		if (nrm.dot(best.normal) < 0) nrm = -nrm;
+		SensorPlane refit{nrm, -nrm.dot(mean)};
+		SensorMount m;
+		if (!accepted(refit, m)) return std::nullopt;
+		best = refit;
+		bestCount = k;
+	}
+	if (inliersOut) *inliersOut = bestCount;
+	return best;
+}
+
 }  // namespace gam

@@ -3,6 +3,7 @@
 #include <gam/maps/MapRegistry.h>
 #include <gam/maps/ObservationAdapters.h>
 #include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/core/format.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -84,7 +85,9 @@ const bool kTraitsRegistered = [] {
 			r.a = p.a, r.b = p.b, r.c = p.c, r.d = p.d;
 		}
 		r.nodes = det.nodes.size();
-		r.status = gam::GroundDetection::statusName(det.status);
+		// "mount_floor": the tree's plane was too far from the robot's floor,
+		// the frame was judged against that floor (max_ground_offset).
+		r.status = det.ok() && det.ground_from_mount ? "mount_floor" : gam::GroundDetection::statusName(det.status);
 		const auto it = g.mountChecks().find(g.lastSensorLabel());
 		if (it != g.mountChecks().end() && it->second.status().has_last && r.found)
 		{
@@ -117,6 +120,28 @@ const bool kTraitsRegistered = [] {
 				s.alarm
 					? ": MOUNT ALARM, the declared sensorPose is wrong or the camera moved (gam-calibrate measures it)"
 					: (s.alarms_raised ? ": the alarm was raised and cleared again" : ""));
+			out += (out.empty() ? "" : "\n") + std::string(b);
+		}
+		const gam::PipelineParams& pp = g.groundOptions().pipeline;
+		for (const auto& [label, cam] : g.cameras())
+		{
+			if (pp.ism.model == gam::MethodVariant::Paper) break;  // the paper's model has no camera noise
+			char b[512];
+			const char* name = gam::kCameraModelNames[int(cam.model)];
+			const bool unknown = cam.model == gam::CameraModel::Custom && pp.camera.model == gam::CameraModel::Auto;
+			const std::string trust =
+				!pp.camera.range_of_trust
+					? std::string("range_of_trust off")
+					: (std::isfinite(cam.trust_range) && cam.trust_range < pp.projection.max_range
+						   ? "range of trust " + mrpt::format("%.2f m", cam.trust_range)
+						   : "range of trust: the whole max_range " + mrpt::format("%.2f m", pp.projection.max_range));
+			std::snprintf(
+				b, sizeof b, "camera %s: %s%s (%dx%d, %.2f m above the floor), %s for a %.3f m hazard at %.1f sigma",
+				label.c_str(), unknown ? "unknown" : name,
+				unknown ? " (camera_model = auto found no model for this frame size and label: no noise model; set "
+						  "camera_model)"
+						: (pp.camera.model == gam::CameraModel::Auto ? " (auto)" : ""),
+				cam.width, cam.height_px, cam.height, trust.c_str(), pp.ism.traversable_step, pp.ism.noise_sigmas);
 			out += (out.empty() ? "" : "\n") + std::string(b);
 		}
 		return out;
@@ -380,6 +405,16 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 	m_pipeline.process(
 		frame, Eigen::Vector3d(robotPose.x(), robotPose.y(), robotPose.z()),
 		gam::GridLattice{getXMin(), getYMin(), getResolution()});
+	{
+		TCameraInfo& cam = m_cameras[obs.sensorLabel];
+		const gam::FrameResult& res = m_pipeline.result();
+		cam.model = res.camera;
+		cam.trust_range = res.trust_range;
+		cam.height = frame.sensor_position.z() - robotPose.z();
+		cam.width = frame.intrinsics.width;
+		cam.height_px = frame.intrinsics.height;
+		cam.frames++;
+	}
 	if (m_options.mount.enabled)
 	{
 		// The floor in the sensor's own frame says where the sensor is: compare
@@ -394,7 +429,8 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 			T.translation() = Eigen::Vector3d(w.x(), w.y(), w.z());
 			// The sensor's distance to the floor is its height (the robot's
 			// origin is on the floor, so the declared z is a height too).
-			measured = gam::mountFromFloor(gam::planeInSensorFrame(det.plane(), T));
+			measured =
+				gam::mountFromFloor(gam::planeInSensorFrame(det.ground_from_mount ? det.tree_plane : det.plane(), T));
 		}
 		mon->second.update({declared.z(), declared.pitch(), declared.roll()}, measured);
 	}

@@ -66,6 +66,7 @@ bool toSensorFrame(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3
 	using namespace mrpt::obs;
 	if (!finitePose(robotPose)) throw std::invalid_argument("robot pose is not finite");
 	out = SensorFrame{};
+	out.sensor_label = obs.sensorLabel;
 	if (const auto* o3 = dynamic_cast<const CObservation3DRangeScan*>(&obs))
 	{
 		o3->load();  // externally stored images

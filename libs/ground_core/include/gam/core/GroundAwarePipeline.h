@@ -9,7 +9,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 
+#include "gam/core/CameraNoise.h"
 #include "gam/core/DepthProjector.h"
 #include "gam/core/ElevationGrid.h"
 #include "gam/core/InverseSensorModel.h"
@@ -41,6 +43,18 @@ struct PipelineParams
 	IsmParams ism;
 	/** Missing floor (depth images only; not in the paper's model). */
 	MissingFloorParams missing;
+	/** The camera's noise and the range of trust (not in the paper's model). */
+	CameraParams camera;
+	/** A ground plane whose height under the robot is farther than this from
+	 * the floor the robot stands on (the mount's floor) is not the ground: the
+	 * frame's ground becomes that floor (z = the robot's z, level) and the
+	 * tree's plane is dropped. A raised stage or a long box top the tree grew
+	 * on, or a plane fitted to a far floor by a noisy camera and tilted by
+	 * its noise, would otherwise make everything on it free. 0.10 m: beyond
+	 * what a mount within the mount check's tolerances (3 cm, 1.5 deg seen
+	 * 2 m ahead: 5 cm) and a floor's unevenness explain. 0 = off; not in the
+	 * paper's model. [m] */
+	double max_ground_offset = 0.10;
 
 	template <class Self, class Visit>
 	static void forEachParam(Self& p, Visit&& visit)
@@ -55,6 +69,13 @@ struct PipelineParams
 		RrtGpdParams::forEachParam(p.rrt, visit);
 		IsmParams::forEachParam(p.ism, visit);
 		MissingFloorParams::forEachParam(p.missing, visit);
+		CameraParams::forEachParam(p.camera, visit);
+		visit(
+			ParamInfo{
+				"max_ground_offset", 0, 100,
+				"a ground plane this far from the robot's floor under the robot is replaced by that floor [m]; 0 = "
+				"off"},
+			p.max_ground_offset);
 	}
 	/** Every range and every rule between parameters; throws
 	 * std::invalid_argument naming the key. */
@@ -96,6 +117,12 @@ struct FrameResult
 	GroundDetection detection;
 	IsmStats ism;
 	MissingFloorStats missing;
+	/** The camera model whose noise was assumed (camera_model, or what `auto`
+	 * found) and the range of trust it gave at the sensor's height: voxels
+	 * farther away (2D) gave no evidence. +inf when off or not computed
+	 * (paper mode, a frame without intrinsics). [m] */
+	CameraModel camera = CameraModel::Custom;
+	double trust_range = std::numeric_limits<double>::infinity();
 	StageTimes ms;
 };
 

@@ -66,7 +66,7 @@ struct RrtGpdParams
 	 * ransac_inlier_distance within d_n (a ramp's foot), add nodes s_x by s_y
 	 * cells apart in the 8 directions, with the tree's own tests (E_th
 	 * against the parent's local plane, max_fit_rms, N_th), until the surface
-	 * meets the ground plane again or the tree has K + 1 nodes. The random
+	 * meets the ground plane again or K nodes were added. The random
 	 * tree puts a node every ~d_n and reaches a narrow ramp only through its
 	 * foot: a 0.7 m wide 8 deg ramp got a handful of nodes near its foot in
 	 * 4 of 11 frames, too few (and too collinear) for a patch of its own;
@@ -168,6 +168,10 @@ struct GroundDetection
 	 * of band about the seed's local plane. */
 	double patch_inlier_distance = 0;
 	int iterations = 0;
+	/** planes[0] is the mount's floor, not the tree's plane: the tree's was
+	 * farther from the robot's floor than max_ground_offset (the pipeline). */
+	bool ground_from_mount = false;
+	Plane tree_plane;  ///< the tree's plane when ground_from_mount (the mount check measures it)
 
 	bool ok() const { return status == Status::Ok; }
 	const Plane& plane() const { return planes.front(); }
@@ -182,6 +186,7 @@ struct GroundDetection
 		fill_nodes = 0;
 		patch_inlier_distance = 0;
 		iterations = 0;
+		ground_from_mount = false;
 	}
 	static const char* statusName(Status s);
 	std::string describe() const;

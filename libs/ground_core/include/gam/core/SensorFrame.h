@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <limits>
+#include <string_view>
 
 #include "gam/core/DepthProjector.h"
 #include "gam/core/ElevationGrid.h"
@@ -20,6 +21,8 @@ struct SensorFrame
 	RigidTransform sensor_to_map;
 	/** The sensor's position in the map frame (double: the ISM's reference). */
 	Eigen::Vector3d sensor_position = Eigen::Vector3d::Zero();
+	/** The sensor's label (camera_model = auto reads it); may be empty. */
+	std::string_view sensor_label;
 	/** The sensor's own range limit, applied on top of the projection filter. */
 	float max_range = std::numeric_limits<float>::infinity();
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -41,6 +42,34 @@ SensorPlane planeInSensorFrame(const Plane& world, const Eigen::Isometry3d& worl
  * and the height is d. std::nullopt if the normal is not finite or the floor
  * plane passes through the sensor (d <= 0 after orientation). */
 std::optional<SensorMount> mountFromFloor(const SensorPlane& floorInSensor);
+
+/** How far from the declared mount the floor may be (issue #27: a rough
+ * guess of height +- 0.3 m, pitch +- 20 deg, roll +- 10 deg). */
+struct FloorSearchParams
+{
+	double height_tolerance = 0.30;            ///< [m]
+	double pitch_tolerance = 20 * M_PI / 180;  ///< [rad]
+	double roll_tolerance = 10 * M_PI / 180;   ///< [rad]
+	/** A point within this of a candidate plane is its inlier: 2 cm, or
+	 * 1 % of the point's range where the camera is noisier (stereo, far). [m] */
+	double inlier_distance = 0.02;
+	double inlier_distance_per_m = 0.01;
+	int iterations = 400;
+	size_t min_inliers = 200;
+};
+/** Searches sensor-frame points (MRPT's sensor frame) for the floor of a
+ * camera mounted about at `guess`: RANSAC over planes through 3 points whose
+ * mount (mountFromFloor) lies within the tolerances of the guess; the one
+ * with the most inliers, refitted to them (total least squares). A table top
+ * or a wall lies outside the tolerances (a table is more than 0.3 m nearer
+ * than the floor, a wall is 90 deg off), so the floor wins even when it
+ * fills less of the image. The result does not depend on the guess as long
+ * as the floor is within the tolerances of it: calibrating again from the
+ * answer finds the same plane (same points, same `seed`). std::nullopt if no
+ * plane has min_inliers. */
+std::optional<SensorPlane> searchFloor(
+	const std::vector<Eigen::Vector3d>& sensorPoints, const SensorMount& guess, const FloorSearchParams& p,
+	unsigned seed = 1, size_t* inliers = nullptr);
 
 /** A mount estimated from many frames: the mean of the frames kept, and the
  * standard error of each mean (std / sqrt(used)). */

@@ -143,6 +143,18 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	const std::map<std::string, gam::MountMonitor>& mountChecks() const { return m_mounts; }
 	/** True while the mount alarm of any sensor is on. */
 	bool mountAlarm() const;
+	/** The camera per sensor label, as the last depth frame of that label
+	 * found it: its model (camera_model, or what `auto` read from the frame),
+	 * its range of trust and the sensor's height above the floor. */
+	struct TCameraInfo
+	{
+		gam::CameraModel model = gam::CameraModel::Custom;
+		double trust_range = 0;  ///< [m]; +inf when not limited
+		double height = 0;       ///< sensor above the robot's floor [m]
+		int width = 0, height_px = 0;
+		size_t frames = 0;
+	};
+	const std::map<std::string, TCameraInfo>& cameras() const { return m_cameras; }
 	/** The label of the last depth frame's sensor (its entry in mountChecks()). */
 	const std::string& lastSensorLabel() const { return m_lastSensorLabel; }
 
@@ -230,6 +242,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	TFrameTimes m_times;
 	std::map<std::string, gam::MountMonitor> m_mounts;  // not serialized: state of a run
 	std::string m_lastSensorLabel;
+	std::map<std::string, TCameraInfo> m_cameras;  // not serialized: state of a run
 	mutable COccupancyGridMap2D m_missingLayer;
 	// Cells that only 2D scans made occupied (lowest cell value; anything else
 	// = the camera's or unknown provenance, which scans never free). State of
