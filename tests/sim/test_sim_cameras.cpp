@@ -106,8 +106,7 @@ TEST(SimCameras, CorrelatedDisparityNoiseIsSharedByNeighbours)
 	// With only the correlated field (0.05 px rms over 16 px), horizontally adjacent
 	// pixels err almost alike (bilinear: correlation > 0.9 one pixel apart); with only
 	// per-pixel noise they are independent (|correlation| < 0.05).
-	auto neighbourCorrelation = [](double perPixel, double correlated)
-	{
+	auto neighbourCorrelation = [](double perPixel, double correlated) {
 		KinectParams p = cameraPreset(CameraModel::D435);
 		p.disp_sigma_px = perPixel;
 		p.disp_corr_sigma_px = correlated;
