@@ -332,6 +332,14 @@ std::string ViewerModel::statusText() const
 		o << "voxels: ground " << d.ism.ground << ", obstacle " << d.ism.obstacle << ", drop " << d.ism.drop
 		  << ", overhead " << d.ism.overhead << ", out of range " << d.ism.out_of_range << ", drop-ray cells "
 		  << d.ism.drop_ray_cells << "; points " << d.points << "\n";
+		if (d.camera != gam::CameraModel::Custom || std::isfinite(d.trust_range))
+		{
+			o << "camera: " << gam::kCameraModelNames[int(d.camera)];
+			if (std::isfinite(d.trust_range))
+				o << ", range of trust " << d.trust_range << " m (no evidence farther: its noise hides a "
+				  << m_ga->groundOptions().pipeline.ism.traversable_step << " m hazard there)";
+			o << "\n";
+		}
 		o << "stages [ms]: projection " << d.ms.projection << ", outliers " << d.ms.outliers << ", ground "
 		  << d.ms.ground << ", ism " << d.ms.ism << ", update " << m_ga->lastFrameTimes().update << ", total "
 		  << m_ga->lastFrameTimes().total << "\n";
