@@ -123,8 +123,7 @@ TEST(CameraNoise, NoEvidenceBeyondTheRangeOfTrust)
 	frame.sensor_position = camPos;
 	frame.sensor_label = "KINECT";  // a label that names no model: the frame decides
 
-	auto farthestEvidence = [&](bool trust, CameraModel& model, double& trustRangeOut)
-	{
+	auto farthestEvidence = [&](bool trust, CameraModel& model, double& trustRangeOut) {
 		PipelineParams params;
 		params.camera.range_of_trust = trust;
 		GroundAwarePipeline pipeline(params);
@@ -198,8 +197,7 @@ TEST(GroundOffset, AStageTheTreeGrewOnIsNoFloor)
 	frame.sensor_to_map.t = camPos.cast<float>();
 	frame.sensor_position = camPos;
 
-	auto stageEvidence = [&](double limit, bool& fromMount)
-	{
+	auto stageEvidence = [&](double limit, bool& fromMount) {
 		PipelineParams params;
 		params.max_ground_offset = limit;
 		GroundAwarePipeline pipeline(params);

@@ -56,8 +56,7 @@ CameraNoise cameraNoisePreset(CameraModel model)
 			n.disp_step = 1.0 / 8;
 			break;
 		case CameraModel::Auto:
-		case CameraModel::Custom:
-			break;
+		case CameraModel::Custom: break;
 	}
 	return n;
 }

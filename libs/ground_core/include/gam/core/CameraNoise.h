@@ -97,10 +97,14 @@ struct CameraParams
 		visit(
 			ParamInfo{"range_of_trust", 0, 1, "no evidence where the camera cannot tell traversable_step from noise"},
 			p.range_of_trust);
-		visit(ParamInfo{"custom_noise_c0", 0, 1, "camera_model=custom: ToF sigma = c0 + c1 z + c2 z^2, c0 [m]"}, p.custom.tof_c0);
+		visit(
+			ParamInfo{"custom_noise_c0", 0, 1, "camera_model=custom: ToF sigma = c0 + c1 z + c2 z^2, c0 [m]"},
+			p.custom.tof_c0);
 		visit(ParamInfo{"custom_noise_c1", -1, 1, "c1 [-]"}, p.custom.tof_c1);
 		visit(ParamInfo{"custom_noise_c2", 0, 1, "c2 [1/m]"}, p.custom.tof_c2);
-		visit(ParamInfo{"custom_baseline", 0, 10, "stereo/projector baseline [m] (0: no disparity noise)"}, p.custom.baseline);
+		visit(
+			ParamInfo{"custom_baseline", 0, 10, "stereo/projector baseline [m] (0: no disparity noise)"},
+			p.custom.baseline);
 		visit(ParamInfo{"custom_disp_sigma", 0, 100, "per-pixel disparity noise [px]"}, p.custom.disp_sigma);
 		visit(ParamInfo{"custom_disp_corr_sigma", 0, 100, "correlated disparity noise [px]"}, p.custom.disp_corr_sigma);
 		visit(ParamInfo{"custom_disp_step", 0, 10, "disparity quantisation step [px]"}, p.custom.disp_step);
