@@ -494,9 +494,9 @@ TEST(LiveProgram, MaxSecondsAndSigtermEndTheRunWithTheMaps)
 	const std::string dir = freshDir("prog_max"), out = dir + "/out";
 	writeFile(dir + "/sensors.ini", cameraIni(dir, "0,0,0"));
 	const Child c =
-		startMapper(dir, {"--live", dir + "/sensors.ini", "-p", kPlugin, "--out", out, "--max-seconds", "1.5", "-q"});
+		startMapper(dir, {"--live", dir + "/sensors.ini", "-p", kPlugin, "--out", out, "--max-seconds", "2.5", "-q"});
 	EXPECT_EQ(waitExit(c), 0) << slurp(c.errFile);
-	EXPECT_NE(slurp(c.outFile).find("stopped: --max-seconds 1.5"), std::string::npos) << slurp(c.outFile);
+	EXPECT_NE(slurp(c.outFile).find("stopped: --max-seconds 2.5"), std::string::npos) << slurp(c.outFile);
 	expectTheScene(out);
 
 	const std::string out2 = dir + "/out2";

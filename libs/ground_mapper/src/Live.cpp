@@ -254,15 +254,18 @@ LiveSummary runLive(Mapper& mapper, const LiveOptions& live, const std::atomic<b
 	const int launchGapMs = ini.read_int("global", "time_between_launches", 300, false);
 	const int gzLevel = ini.read_int("global", "rawlog_GZ_compress_level", 1, false);
 
+	mapper.begin();
 	mrpt::io::CFileGZOutputStream recordFile;
 	mrpt::serialization::CArchive::UniquePtr record;
 	if (!live.recordPath.empty())
 	{
 		if (!recordFile.open(live.recordPath, std::max(0, std::min(9, gzLevel))))
+		{
+			mapper.abort();
 			throw RunError("cannot write --record file " + live.recordPath);
+		}
 		record = mrpt::serialization::archiveUniquePtrFrom(recordFile);
 	}
-	mapper.begin();
 
 	// 2. The sensors: one thread each, started one after the other; each
 	// initialize() must succeed before the next device is opened.
@@ -279,6 +282,9 @@ LiveSummary runLive(Mapper& mapper, const LiveOptions& live, const std::atomic<b
 			mrpt::system::thread_name(name.substr(0, 15), threads.threads.back());
 			const std::string err = f.get();
 			if (!err.empty()) throw RunError(where + ": initialize() failed: " + err);
+			// A driver's initialize() cannot be interrupted; a stop asked meanwhile
+			// ends the run before the next device is opened.
+			if (stop) throw RunError("stopped while the sensors were starting (after " + where + ")");
 			if (i + 1 < sensors.size() && launchGapMs > 0)
 				std::this_thread::sleep_for(std::chrono::milliseconds(launchGapMs));
 		}
