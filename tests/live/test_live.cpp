@@ -429,7 +429,7 @@ TEST(LiveInProcess, SensorsIniErrorsAreOneLineAndNameTheSection)
 // ------------------------------------------------------------ the program
 namespace
 {
-const std::string kExe = GAM_MAPPER_EXE;
+const std::string kExe = GAM_MAPPER_EXE, kLiveExe = GAM_MAPPER_LIVE_EXE;
 const std::string kPlugin = GAM_SIM_SENSOR_PLUGIN;
 
 struct Child
@@ -540,4 +540,19 @@ TEST(LiveProgram, ErrorsAreOneLineWithExitCodes)
 	EXPECT_EQ(rc, 2);
 	EXPECT_EQ(e.rfind("ground-aware-mapper: error: --plugins " + dir + "/nope.so: ", 0), 0u) << e;
 	EXPECT_FALSE(fs::exists(out + "/ground_aware.yaml"));
+}
+
+// The offline program does not load MRPT's sensor drivers (they cost every run
+// start-up time and memory); a --live command line goes to its live half.
+TEST(LiveProgram, OnlyTheLiveHalfLinksTheSensorDrivers)
+{
+	const std::string dir = freshDir("prog_ldd");
+	auto libs = [&](const std::string& exe) {
+		EXPECT_EQ(std::system(("ldd '" + exe + "' > '" + dir + "/ldd.txt'").c_str()), 0);
+		return slurp(dir + "/ldd.txt");
+	};
+	const std::string offline = libs(kExe), live = libs(kLiveExe);
+	EXPECT_NE(offline.find("libmrpt-maps"), std::string::npos) << offline;
+	EXPECT_EQ(offline.find("libmrpt-hwdrivers"), std::string::npos) << offline;
+	EXPECT_NE(live.find("libmrpt-hwdrivers"), std::string::npos) << live;
 }
