@@ -223,7 +223,10 @@ TEST(LiveInProcess, SnapshotsAppearInTheOutputFolderWhileRunning)
 	auto live = liveOptions(dir + "/sensors.ini");
 	live.snapshotSeconds = 0.2;
 	std::atomic<bool> stop{false};
-	gam::mapper::Mapper mapper(mapperOptions(out));
+	// --snapshot-every (per frames) too: its folders are published at the end, as offline.
+	auto mo = mapperOptions(out);
+	mo.snapshotEvery = 1;
+	gam::mapper::Mapper mapper(mo);
 	gam::mapper::LiveSummary s;
 	std::string error;
 	std::thread run([&] {
@@ -258,6 +261,10 @@ TEST(LiveInProcess, SnapshotsAppearInTheOutputFolderWhileRunning)
 	EXPECT_GE(s.snapshots, 1u);
 	EXPECT_NE(s.stopReason.find("stop requested"), std::string::npos) << s.stopReason;
 	expectTheScene(out);
+	EXPECT_EQ(s.run.snapshots, s.run.frames);
+	EXPECT_TRUE(fs::exists(out + "/snapshots/000001/ground_aware.pgm"));
+	const std::string index = slurp(out + "/snapshots/index.csv");
+	EXPECT_EQ(size_t(std::count(index.begin(), index.end(), '\n')), s.run.frames + 1) << index;
 }
 
 // Odometry from a sensor section of its own: the robot stands 1 m behind the
@@ -332,6 +339,11 @@ TEST(LiveInProcess, MaxFramesEndsTheRunAndTheRecordHoldsEveryObservation)
 	EXPECT_EQ(n, s.received);
 	EXPECT_EQ(scans, s.received);
 	EXPECT_GE(n, 4u);
+	// ... and the offline mode replays it: every recorded scan is a frame.
+	auto offline = mapperOptions(dir + "/replay");
+	offline.rawlogPath = live.recordPath;
+	gam::mapper::Mapper replay(offline);
+	EXPECT_EQ(replay.run().frames, scans);
 }
 
 // A driver that fails while running (a camera unplugged): the run ends, the
