@@ -23,7 +23,7 @@ struct LiveOptions
 	/** Every this many seconds the maps' outputs are written into
 	 * MapperOptions::outDir (Mapper::publishMapsNow); 0 = only at the end. */
 	double snapshotSeconds = 10;
-	double maxSeconds = 0;  ///< > 0: end the run after this long (from the first frame wait)
+	double maxSeconds = 0;  ///< > 0: end the run this long after every sensor has started
 	size_t maxFrames = 0;   ///< > 0: end the run after this many frames were inserted
 	/** If set: every observation received (all classes, in the order they were
 	 * processed) goes into this rawlog (observations format, gzip level of
@@ -61,9 +61,10 @@ std::vector<std::string> checkSensorsIni(const std::string& sensorsIniPath);
  * process_rate); the calling thread maps. The run ends when `stop` becomes
  * true (e.g. from a SIGINT handler), at maxFrames / maxSeconds, or when a
  * sensor fails; then the sensors stop and the final maps are written as the
- * offline mode writes them. Throws ConfigError (the .ini files), RunError (a
- * sensor's initialize() failing, naming its section and MRPT's reason; no
- * frame at all; output errors). */
+ * offline mode writes them. Throws ConfigError (the sensors .ini, as
+ * checkSensorsIni()), RunError (a sensor's initialize() failing, naming its
+ * section and MRPT's reason; a stop while the sensors start; no frame at all;
+ * output errors), with nothing written. */
 LiveSummary runLive(Mapper& mapper, const LiveOptions& live, const std::atomic<bool>& stop);
 
 }  // namespace gam::mapper
