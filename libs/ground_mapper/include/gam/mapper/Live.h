@@ -64,7 +64,8 @@ std::vector<std::string> checkSensorsIni(const std::string& sensorsIniPath);
  * offline mode writes them. Throws ConfigError (the sensors .ini, as
  * checkSensorsIni()), RunError (a sensor's initialize() failing, naming its
  * section and MRPT's reason; a stop while the sensors start; no frame at all;
- * output errors), with nothing written. */
+ * a frame a map rejects; output errors); then the final outputs are not
+ * written (snapshots already in outDir stay). */
 LiveSummary runLive(Mapper& mapper, const LiveOptions& live, const std::atomic<bool>& stop);
 
 }  // namespace gam::mapper
