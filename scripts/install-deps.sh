@@ -9,7 +9,7 @@
 #          pulls ROS 1, OpenCV, Qt 5 and GTK: on a bare system the group is
 #          ~280 packages, ~210 MB, instead of ~740, ~430 MB).
 #   all    everything: the demo's packages plus the whole MRPT (its apps and
-#          data), wxWidgets (ground-aware-viewer), GoogleTest, Google
+#          data, its sensor drivers for ground-aware-mapper --live), wxWidgets (ground-aware-viewer), GoogleTest, Google
 #          Benchmark, Xvfb, GNU time, clang (sanitizers, fuzzers, clang-format) and the
 #          Python modules of rawlog_tools. scripts/run-tests.sh and CI need all.
 #   --check  install nothing: exit 0 if every package of the groups is
@@ -24,6 +24,7 @@ DEMO_PKGS=(
 REST_PKGS=(
   git pkg-config file
   libmrpt-dev mrpt-apps mrpt-common
+  libmrpt-hwdrivers-dev  # ground-aware-mapper --live (MRPT's sensor drivers; CMake looks for mrpt-hwdrivers)
   libwxgtk3.2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth

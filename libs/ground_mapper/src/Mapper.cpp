@@ -190,11 +190,254 @@ struct TmpDir
 bool stderrIsTty() { return isatty(2) != 0; }
 }  // namespace
 
+// The state of a run between begin() and end().
+struct Mapper::RunState
+{
+	std::chrono::steady_clock::time_point tStart;
+	RunSummary s;
+	TmpDir tmp;
+	std::ofstream timing, planes, snapIndex;
+	std::string snapDir;
+	// Each map's traits (gam/maps/MapRegistry.h); the first map that finds
+	// ground planes writes ground_planes.csv.
+	std::vector<const gam::maps::MapTraits*> traits;
+	int planesFrom = -1;
+};
+
+Mapper::~Mapper() = default;
+
+void Mapper::abort() { m_run.reset(); }
+
+const RunSummary& Mapper::runSoFar() const
+{
+	static const RunSummary none;
+	return m_run ? m_run->s : none;
+}
+
+void Mapper::begin()
+{
+	using clk = std::chrono::steady_clock;
+	m_run = std::make_unique<RunState>();
+	RunState& r = *m_run;
+	r.tStart = clk::now();
+	RunSummary& s = r.s;
+
+	// Output directory: create it and a private temporary folder inside it,
+	// so nothing in DIR looks like a finished map until the very end.
+	std::error_code ec;
+	fs::create_directories(m_opts.outDir, ec);
+	if (!fs::is_directory(m_opts.outDir))
+		throw RunError("cannot create output directory " + m_opts.outDir + (ec ? ": " + ec.message() : ""));
+	r.tmp.path = (fs::path(m_opts.outDir) / (".ground-aware-mapper.tmp." + std::to_string(getpid()))).string();
+	fs::remove_all(r.tmp.path, ec);
+	if (!fs::create_directory(r.tmp.path, ec))
+		throw RunError("output directory " + m_opts.outDir + " is not writable" + (ec ? ": " + ec.message() : ""));
+
+	r.timing.open(r.tmp.path + "/timing.csv");
+	r.planes.open(r.tmp.path + "/ground_planes.csv");
+	if (!r.timing || !r.planes) throw RunError("cannot write to " + r.tmp.path);
+	r.timing << "frame,map,stage,ms\n";
+	r.planes << "frame,a,b,c,d,nodes,status,mount_z,mount_pitch_deg,mount_roll_deg,mount_alarm,sensor\n";
+	r.planes << std::setprecision(9);
+	r.timing << std::fixed << std::setprecision(4);
+	// Snapshots (--snapshot-every N): written into the temporary folder too,
+	// published with the rest.
+	r.snapDir = r.tmp.path + "/snapshots";
+	if (m_opts.snapshotEvery)
+	{
+		fs::create_directory(r.snapDir, ec);
+		r.snapIndex.open(r.snapDir + "/index.csv");
+		if (!r.snapIndex) throw RunError("cannot write to " + r.snapDir);
+		r.snapIndex << "snapshot,frames,frame_index,rawlog_entry,robot_x,robot_y,robot_yaw_deg\n";
+		r.snapIndex << std::fixed << std::setprecision(6);
+	}
+
+	s.maps.resize(m_specs.size());
+	for (size_t i = 0; i < m_specs.size(); i++)
+	{
+		s.maps[i].label = m_specs[i].label;
+		s.maps[i].className = m_specs[i].className;
+	}
+	r.traits.assign(m_specs.size(), nullptr);
+	for (size_t i = 0; i < m_specs.size(); i++)
+	{
+		r.traits[i] = gam::maps::findMapTraits(*m_maps.maps[i]);
+		if (r.planesFrom < 0 && r.traits[i] && r.traits[i]->lastGroundPlane) r.planesFrom = int(i);
+	}
+}
+
+void Mapper::insert(Frame& fr)
+{
+	using clk = std::chrono::steady_clock;
+	if (!m_run) throw std::logic_error("Mapper::insert() before begin()");
+	RunState& r = *m_run;
+	RunSummary& s = r.s;
+	if (!m_sensorPoses.empty())
+	{
+		const auto sp = m_sensorPoses.find(fr.obs->sensorLabel);
+		if (sp != m_sensorPoses.end()) fr.obs->setSensorPose(sp->second);
+	}
+	const bool is3D = IS_CLASS(*fr.obs, mrpt::obs::CObservation3DRangeScan);
+	s.frames++;
+	(is3D ? s.frames3D : s.frames2D)++;
+	if (!fr.hasOdometry) s.framesWithoutOdometry++;
+
+	for (size_t i = 0; i < m_specs.size(); i++)
+	{
+		auto& map = *m_maps.maps[i];
+		const auto t0 = clk::now();
+		try
+		{
+			map.insertObservation(*fr.obs, fr.robotPose);
+		}
+		catch (const std::exception& e)
+		{
+			throw RunError(
+				"frame " + std::to_string(fr.index) + " (rawlog entry " + std::to_string(fr.entry) + "), map " +
+				m_specs[i].label + ": " + conciseError(e.what()));
+		}
+		const double ms = std::chrono::duration<double, std::milli>(clk::now() - t0).count();
+		s.maps[i].totalMs.push_back(ms);
+		(is3D ? s.maps[i].ms3D : s.maps[i].ms2D).push_back(ms);
+		const std::string& L = m_specs[i].label;
+		r.timing << fr.index << "," << L << ",total," << ms << "\n";
+		const gam::maps::MapTraits* t = r.traits[i];
+		if (t && t->stageTimes)
+			t->stageTimes(map, is3D, [&](const char* stage, double stageMs) {
+				r.timing << fr.index << "," << L << "," << stage << "," << stageMs << "\n";
+			});
+		gam::maps::GroundPlaneRecord gp;
+		if (int(i) == r.planesFrom && is3D && t->lastGroundPlane(map, gp))
+		{
+			r.planes << fr.index << ",";
+			if (gp.found)
+				r.planes << gp.a << "," << gp.b << "," << gp.c << "," << gp.d;
+			else
+				r.planes << ",,,";
+			r.planes << "," << gp.nodes << "," << gp.status << ",";
+			if (gp.mount_measured)
+				r.planes << gp.mount_z << "," << gp.mount_pitch_deg << "," << gp.mount_roll_deg << ","
+						 << (gp.mount_alarm ? 1 : 0);
+			else
+				r.planes << ",,,";
+			// Several cameras: each frame's plane is its own camera's.
+			r.planes << "," << fr.obs->sensorLabel << "\n";
+		}
+	}
+
+	m_lastPose = fr.robotPose;
+	if (m_opts.localMap)
+		for (size_t i = 0; i < m_specs.size(); i++)
+			if (r.traits[i] && r.traits[i]->keepWindow)
+				r.traits[i]->keepWindow(*m_maps.maps[i], fr.robotPose.x(), fr.robotPose.y(), m_opts.localCells);
+
+	if (m_opts.snapshotEvery && s.frames % m_opts.snapshotEvery == 0)
+	{
+		char name[32];
+		std::snprintf(name, sizeof(name), "%06zu", s.frames);
+		try
+		{
+			writeSnapshot(r.snapDir + "/" + name);
+		}
+		catch (const std::exception& e)
+		{
+			throw RunError("writing snapshot " + std::string(name) + ": " + conciseError(e.what()));
+		}
+		r.snapIndex << name << "," << s.frames << "," << fr.index << "," << fr.entry << "," << fr.robotPose.x() << ","
+					<< fr.robotPose.y() << "," << mrpt::RAD2DEG(fr.robotPose.yaw()) << "\n";
+		s.snapshots++;
+	}
+}
+
+std::vector<std::string> Mapper::publishMapsNow()
+{
+	if (!m_run) throw std::logic_error("Mapper::publishMapsNow() before begin()");
+	// Into a folder of its own inside the temporary one, then file by file
+	// into DIR: rename() replaces a file at once, so a reader of DIR sees the
+	// previous or the new file, never a part of one.
+	const fs::path dir = fs::path(m_run->tmp.path) / "live_snapshot";
+	std::error_code ec;
+	fs::remove_all(dir, ec);
+	std::vector<std::string> files;
+	try
+	{
+		if (!fs::create_directory(dir, ec)) throw std::runtime_error("cannot create " + dir.string());
+		writeMaps(dir.string(), files);
+	}
+	catch (const std::exception& e)
+	{
+		throw RunError("writing a snapshot of the maps: " + conciseError(e.what()));
+	}
+	for (const auto& f : files)
+	{
+		fs::rename(dir / f, fs::path(m_opts.outDir) / f, ec);
+		if (ec) throw RunError("cannot move " + f + " into " + m_opts.outDir + ": " + ec.message());
+	}
+	fs::remove_all(dir, ec);
+	return files;
+}
+
+RunSummary Mapper::end()
+{
+	if (!m_run) throw std::logic_error("Mapper::end() before begin()");
+	RunState& r = *m_run;
+	RunSummary& s = r.s;
+	std::error_code ec;
+	for (size_t i = 0; i < m_specs.size(); i++)
+		if (r.traits[i] && r.traits[i]->runNote)
+		{
+			const std::string note = r.traits[i]->runNote(*m_maps.maps[i]);
+			if (!note.empty()) s.notes.push_back(m_specs[i].label + ": " + note);
+		}
+
+	r.timing.close();
+	r.planes.close();
+	if (!r.timing || !r.planes) throw RunError("cannot write timing.csv / ground_planes.csv in " + r.tmp.path);
+	if (m_opts.snapshotEvery)
+	{
+		r.snapIndex.close();
+		if (!r.snapIndex) throw RunError("cannot write " + r.snapDir + "/index.csv");
+	}
+
+	// Maps.
+	try
+	{
+		writeMaps(r.tmp.path, s.files);
+		std::ofstream cfg(r.tmp.path + "/config_used.ini");
+		cfg << m_opts.configText;
+		if (!cfg) throw std::runtime_error("cannot write config_used.ini");
+	}
+	catch (const std::exception& e)
+	{
+		throw RunError("writing outputs: " + conciseError(e.what()));
+	}
+	s.files.push_back("timing.csv");
+	s.files.push_back("ground_planes.csv");
+	s.files.push_back("config_used.ini");
+
+	// Publish: move everything into DIR.
+	for (const auto& f : s.files)
+	{
+		fs::rename(fs::path(r.tmp.path) / f, fs::path(m_opts.outDir) / f, ec);
+		if (ec) throw RunError("cannot move " + f + " into " + m_opts.outDir + ": " + ec.message());
+	}
+	if (m_opts.snapshotEvery)
+	{
+		// The snapshots of an earlier run go only now, replaced as a whole.
+		const fs::path dst = fs::path(m_opts.outDir) / "snapshots";
+		fs::remove_all(dst, ec);
+		fs::rename(r.snapDir, dst, ec);
+		if (ec) throw RunError("cannot move snapshots into " + m_opts.outDir + ": " + ec.message());
+	}
+	s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - r.tStart).count();
+	RunSummary out = std::move(s);
+	m_run.reset();  // removes the temporary folder
+	return out;
+}
+
 RunSummary Mapper::run()
 {
 	using clk = std::chrono::steady_clock;
-	const auto tStart = clk::now();
-	RunSummary s;
 
 	// 1. Input (before touching DIR).
 	std::unique_ptr<RawlogFrameReader> reader;
@@ -207,52 +450,9 @@ RunSummary Mapper::run()
 		throw RunError(e.what());
 	}
 
-	// 2. Output directory: create it and a private temporary folder inside it,
-	// so nothing in DIR looks like a finished map until the very end.
-	std::error_code ec;
-	fs::create_directories(m_opts.outDir, ec);
-	if (!fs::is_directory(m_opts.outDir))
-		throw RunError("cannot create output directory " + m_opts.outDir + (ec ? ": " + ec.message() : ""));
-	TmpDir tmp;
-	tmp.path = (fs::path(m_opts.outDir) / (".ground-aware-mapper.tmp." + std::to_string(getpid()))).string();
-	fs::remove_all(tmp.path, ec);
-	if (!fs::create_directory(tmp.path, ec))
-		throw RunError("output directory " + m_opts.outDir + " is not writable" + (ec ? ": " + ec.message() : ""));
-
-	std::ofstream timing(tmp.path + "/timing.csv"), planes(tmp.path + "/ground_planes.csv");
-	if (!timing || !planes) throw RunError("cannot write to " + tmp.path);
-	timing << "frame,map,stage,ms\n";
-	planes << "frame,a,b,c,d,nodes,status,mount_z,mount_pitch_deg,mount_roll_deg,mount_alarm,sensor\n";
-	planes << std::setprecision(9);
-	timing << std::fixed << std::setprecision(4);
-	// Snapshots (--snapshot-every N): written into the temporary folder too,
-	// published with the rest.
-	const std::string snapDir = tmp.path + "/snapshots";
-	std::ofstream snapIndex;
-	if (m_opts.snapshotEvery)
-	{
-		fs::create_directory(snapDir, ec);
-		snapIndex.open(snapDir + "/index.csv");
-		if (!snapIndex) throw RunError("cannot write to " + snapDir);
-		snapIndex << "snapshot,frames,frame_index,rawlog_entry,robot_x,robot_y,robot_yaw_deg\n";
-		snapIndex << std::fixed << std::setprecision(6);
-	}
-
-	s.maps.resize(m_specs.size());
-	for (size_t i = 0; i < m_specs.size(); i++)
-	{
-		s.maps[i].label = m_specs[i].label;
-		s.maps[i].className = m_specs[i].className;
-	}
-	// Each map's traits (gam/maps/MapRegistry.h); the first map that finds
-	// ground planes writes ground_planes.csv.
-	std::vector<const gam::maps::MapTraits*> traits(m_specs.size());
-	int planesFrom = -1;
-	for (size_t i = 0; i < m_specs.size(); i++)
-	{
-		traits[i] = gam::maps::findMapTraits(*m_maps.maps[i]);
-		if (planesFrom < 0 && traits[i] && traits[i]->lastGroundPlane) planesFrom = int(i);
-	}
+	// 2. Output directory and the run's files.
+	begin();
+	const RunSummary& s = m_run->s;
 
 	// 3. Frames.
 	const bool tty = stderrIsTty();
@@ -261,6 +461,7 @@ RunSummary Mapper::run()
 		if (progressShown && tty) std::cerr << "\r" << std::string(78, ' ') << "\r" << std::flush;
 		progressShown = false;
 	};
+	const auto tStart = m_run->tStart;
 	auto lastProgress = clk::now();
 	Frame fr;
 	try
@@ -277,81 +478,7 @@ RunSummary Mapper::run()
 				throw RunError(e.what());
 			}
 			if (m_opts.maxFrames && fr.index >= m_opts.maxFrames) break;
-			if (!m_sensorPoses.empty())
-			{
-				const auto sp = m_sensorPoses.find(fr.obs->sensorLabel);
-				if (sp != m_sensorPoses.end()) fr.obs->setSensorPose(sp->second);
-			}
-			const bool is3D = IS_CLASS(*fr.obs, mrpt::obs::CObservation3DRangeScan);
-			s.frames++;
-			(is3D ? s.frames3D : s.frames2D)++;
-			if (!fr.hasOdometry) s.framesWithoutOdometry++;
-
-			for (size_t i = 0; i < m_specs.size(); i++)
-			{
-				auto& map = *m_maps.maps[i];
-				const auto t0 = clk::now();
-				try
-				{
-					map.insertObservation(*fr.obs, fr.robotPose);
-				}
-				catch (const std::exception& e)
-				{
-					throw RunError(
-						"frame " + std::to_string(fr.index) + " (rawlog entry " + std::to_string(fr.entry) + "), map " +
-						m_specs[i].label + ": " + conciseError(e.what()));
-				}
-				const double ms = std::chrono::duration<double, std::milli>(clk::now() - t0).count();
-				s.maps[i].totalMs.push_back(ms);
-				(is3D ? s.maps[i].ms3D : s.maps[i].ms2D).push_back(ms);
-				const std::string& L = m_specs[i].label;
-				timing << fr.index << "," << L << ",total," << ms << "\n";
-				const gam::maps::MapTraits* t = traits[i];
-				if (t && t->stageTimes)
-					t->stageTimes(map, is3D, [&](const char* stage, double stageMs) {
-						timing << fr.index << "," << L << "," << stage << "," << stageMs << "\n";
-					});
-				gam::maps::GroundPlaneRecord gp;
-				if (int(i) == planesFrom && is3D && t->lastGroundPlane(map, gp))
-				{
-					planes << fr.index << ",";
-					if (gp.found)
-						planes << gp.a << "," << gp.b << "," << gp.c << "," << gp.d;
-					else
-						planes << ",,,";
-					planes << "," << gp.nodes << "," << gp.status << ",";
-					if (gp.mount_measured)
-						planes << gp.mount_z << "," << gp.mount_pitch_deg << "," << gp.mount_roll_deg << ","
-							   << (gp.mount_alarm ? 1 : 0);
-					else
-						planes << ",,,";
-					// Several cameras: each frame's plane is its own camera's.
-					planes << "," << fr.obs->sensorLabel << "\n";
-				}
-			}
-
-			m_lastPose = fr.robotPose;
-			if (m_opts.localMap)
-				for (size_t i = 0; i < m_specs.size(); i++)
-					if (traits[i] && traits[i]->keepWindow)
-						traits[i]->keepWindow(*m_maps.maps[i], fr.robotPose.x(), fr.robotPose.y(), m_opts.localCells);
-
-			if (m_opts.snapshotEvery && s.frames % m_opts.snapshotEvery == 0)
-			{
-				char name[32];
-				std::snprintf(name, sizeof(name), "%06zu", s.frames);
-				try
-				{
-					writeSnapshot(snapDir + "/" + name);
-				}
-				catch (const std::exception& e)
-				{
-					throw RunError("writing snapshot " + std::string(name) + ": " + conciseError(e.what()));
-				}
-				snapIndex << name << "," << s.frames << "," << fr.index << "," << fr.entry << "," << fr.robotPose.x()
-						  << "," << fr.robotPose.y() << "," << mrpt::RAD2DEG(fr.robotPose.yaw()) << "\n";
-				s.snapshots++;
-			}
+			insert(fr);
 
 			if (m_opts.progress)
 			{
@@ -373,62 +500,20 @@ RunSummary Mapper::run()
 	catch (...)
 	{
 		clearProgress();
+		abort();
 		throw;
 	}
 	clearProgress();
 	if (s.frames == 0)
+	{
+		abort();
 		throw RunError(
 			"no usable observation in " + m_opts.rawlogPath + " (" + std::to_string(reader->entriesRead()) +
 			" entries; need CObservation3DRangeScan or CObservation2DRangeScan with data)");
-
-	for (size_t i = 0; i < m_specs.size(); i++)
-		if (traits[i] && traits[i]->runNote)
-		{
-			const std::string note = traits[i]->runNote(*m_maps.maps[i]);
-			if (!note.empty()) s.notes.push_back(m_specs[i].label + ": " + note);
-		}
-
-	timing.close();
-	planes.close();
-	if (!timing || !planes) throw RunError("cannot write timing.csv / ground_planes.csv in " + tmp.path);
-	if (m_opts.snapshotEvery)
-	{
-		snapIndex.close();
-		if (!snapIndex) throw RunError("cannot write " + snapDir + "/index.csv");
 	}
 
-	// 4. Maps.
-	try
-	{
-		writeMaps(tmp.path, s);
-		std::ofstream cfg(tmp.path + "/config_used.ini");
-		cfg << m_opts.configText;
-		if (!cfg) throw std::runtime_error("cannot write config_used.ini");
-	}
-	catch (const std::exception& e)
-	{
-		throw RunError("writing outputs: " + conciseError(e.what()));
-	}
-	s.files.push_back("timing.csv");
-	s.files.push_back("ground_planes.csv");
-	s.files.push_back("config_used.ini");
-
-	// 5. Publish: move everything into DIR.
-	for (const auto& f : s.files)
-	{
-		fs::rename(fs::path(tmp.path) / f, fs::path(m_opts.outDir) / f, ec);
-		if (ec) throw RunError("cannot move " + f + " into " + m_opts.outDir + ": " + ec.message());
-	}
-	if (m_opts.snapshotEvery)
-	{
-		// The snapshots of an earlier run go only now, replaced as a whole.
-		const fs::path dst = fs::path(m_opts.outDir) / "snapshots";
-		fs::remove_all(dst, ec);
-		fs::rename(snapDir, dst, ec);
-		if (ec) throw RunError("cannot move snapshots into " + m_opts.outDir + ": " + ec.message());
-	}
-	s.seconds = std::chrono::duration<double>(clk::now() - tStart).count();
-	return s;
+	// 4. Maps, 5. publish.
+	return end();
 }
 
 }  // namespace gam::mapper

@@ -12,7 +12,7 @@ namespace fs = std::filesystem;
 
 namespace gam::mapper
 {
-void Mapper::writeMaps(const std::string& dir, RunSummary& s)
+void Mapper::writeMaps(const std::string& dir, std::vector<std::string>& files)
 {
 	for (size_t i = 0; i < m_specs.size(); i++)
 	{
@@ -29,7 +29,7 @@ void Mapper::writeMaps(const std::string& dir, RunSummary& s)
 			ctx.robotY = m_lastPose.y();
 			ctx.localCells = m_opts.localCells;
 			ctx.pngLegend = m_opts.pngLegend;
-			t->writeOutputs(map, ctx, s.files);
+			t->writeOutputs(map, ctx, files);
 		}
 		else
 		{
@@ -44,7 +44,7 @@ void Mapper::writeMaps(const std::string& dir, RunSummary& s)
 			for (const auto& de : fs::directory_iterator(dir))
 			{
 				const auto n = de.path().filename().string();
-				if (!before.count(n) && de.is_regular_file()) s.files.push_back(n);
+				if (!before.count(n) && de.is_regular_file()) files.push_back(n);
 			}
 		}
 	}

@@ -8,8 +8,11 @@
 #include <mrpt/maps/CMultiMetricMap.h>
 #include <mrpt/maps/TMetricMapInitializer.h>
 
-#include <csignal>
+#include <gam/mapper/RawlogFrames.h>
+
+#include <atomic>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -52,9 +55,10 @@ struct MapperOptions
 	 * missing floor in orange. The map_server files are unchanged. */
 	bool pngLegend = false;
 	bool progress = true;
-	/** If set, checked before every frame: non-zero stops the run (RunError
-	 * "interrupted"; nothing is published in outDir). For SIGINT/SIGTERM handlers. */
-	const volatile std::sig_atomic_t* stopRequested = nullptr;
+	/** If set, checked before every frame: true stops the run (RunError
+	 * "interrupted"; nothing is published in outDir). For SIGINT/SIGTERM
+	 * handlers (gam/mapper/StopSignal.h). */
+	const std::atomic<bool>* stopRequested = nullptr;
 };
 
 /** One map of the .ini, in CMultiMetricMap order. */
@@ -117,8 +121,31 @@ class Mapper
    public:
 	/** Parses the configuration and creates the maps. Throws ConfigError. */
 	explicit Mapper(const MapperOptions& opts);
+	~Mapper();
 	/** Runs over the rawlog and writes the outputs. Throws RunError. */
 	RunSummary run();
+
+	/** @name The run in steps, for frames that do not come from a rawlog (the
+	 * live mode, runLive()). run() is begin(), insert() per frame, end().
+	 * @{ */
+	/** Creates DIR and the run's private temporary folder in it; the run's
+	 * files are written there. Throws RunError. */
+	void begin();
+	/** Inserts one frame into every map: [sensor_poses], timing.csv,
+	 * ground_planes.csv, the local window, --snapshot-every. Throws RunError. */
+	void insert(Frame& fr);
+	/** The outputs of every map as they are now, moved into DIR file by file
+	 * (each write is a rename, so DIR never holds a part-written file); the
+	 * run goes on. Returns the file names. Throws RunError. */
+	std::vector<std::string> publishMapsNow();
+	/** Writes every output and moves them into DIR; ends the run. The caller
+	 * checks first that there was a frame. Throws RunError. */
+	RunSummary end();
+	/** Ends the run without writing anything (removes the temporary folder). */
+	void abort();
+	/** The summary of the run so far (frames, per-map timing). */
+	const RunSummary& runSoFar() const;
+	/** @} */
 
 	mrpt::maps::CMultiMetricMap& maps() { return m_maps; }
 	const std::vector<MapSpec>& specs() const { return m_specs; }
@@ -128,7 +155,7 @@ class Mapper
 	const std::string& initialMapNote() const { return m_initialMapNote; }
 
    private:
-	void writeMaps(const std::string& tmpDir, RunSummary& s);
+	void writeMaps(const std::string& dir, std::vector<std::string>& files);
 	/** The map_server maps of every 2D grid into `dir` (created). Throws std::runtime_error. */
 	void writeSnapshot(const std::string& dir) const;
 	MapperOptions m_opts;
@@ -141,6 +168,8 @@ class Mapper
 	/** [sensor_poses] of the .ini: sensorPose per sensor label, replacing the
 	 * rawlog's (gam-calibrate --write-ini writes it). */
 	std::map<std::string, mrpt::poses::CPose3D> m_sensorPoses;
+	struct RunState;
+	std::unique_ptr<RunState> m_run;  ///< between begin() and end()
 };
 
 }  // namespace gam::mapper
