@@ -102,25 +102,11 @@ TEST(CameraNoise, NoEvidenceBeyondTheRangeOfTrust)
 	K.cy = 239.5;
 	const Eigen::Vector3d camPos(0, 0, 1.0);
 	const Eigen::Matrix3d R = Eigen::AngleAxisd(deg2rad(25), Eigen::Vector3d::UnitY()).toRotationMatrix();
-	std::vector<uint16_t> depth(size_t(K.width * K.height), 0);
-	for (int r = 0; r < K.height; r++)
-		for (int c = 0; c < K.width; c++)
-		{
-			const Eigen::Vector3d w = R * Eigen::Vector3d(1.0, (K.cx - c) / K.fx, (K.cy - r) / K.fy);
-			if (w.z() >= 0) continue;
-			const double t = -camPos.z() / w.z();  // depth along X (ray.x = 1)
-			if (t < 6.0) depth[size_t(r * K.width + c)] = uint16_t(std::lround(t * 1000));
-		}
-	SensorFrame frame;
-	frame.has_image = true;
-	frame.image.data = depth.data();
-	frame.image.rows = K.height;
-	frame.image.cols = K.width;
-	frame.image.stride = size_t(K.width);
-	frame.intrinsics = K;
-	frame.sensor_to_map.R = R.cast<float>();
-	frame.sensor_to_map.t = camPos.cast<float>();
-	frame.sensor_position = camPos;
+	const std::vector<uint16_t> depth = gamtest::renderDepth(K, R, [&](const Eigen::Vector3d& w) {
+		const double t = w.z() < 0 ? -camPos.z() / w.z() : -1.0;  // depth along X (ray.x = 1)
+		return t < 6.0 ? t : -1.0;
+	});
+	SensorFrame frame = gamtest::depthFrame(depth, K, R, camPos);
 	frame.sensor_label = "KINECT";  // a label that names no model: the frame decides
 
 	auto farthestEvidence = [&](bool trust, CameraModel& model, double& trustRangeOut) {
@@ -170,32 +156,19 @@ TEST(GroundOffset, AStageTheTreeGrewOnIsNoFloor)
 	K.cy = 59.5;
 	const Eigen::Vector3d camPos(0, 0, 1.0);
 	const Eigen::Matrix3d R = Eigen::AngleAxisd(deg2rad(25), Eigen::Vector3d::UnitY()).toRotationMatrix();
-	std::vector<uint16_t> depth(size_t(K.width * K.height), 0);
-	for (int r = 0; r < K.height; r++)
-		for (int c = 0; c < K.width; c++)
+	const std::vector<uint16_t> depth = gamtest::renderDepth(K, R, [&](const Eigen::Vector3d& w) {
+		if (w.z() >= 0) return -1.0;
+		double t = (0.20 - camPos.z()) / w.z();  // the stage's top
+		Eigen::Vector3d q = camPos + t * w;
+		if (!(q.x() >= 1.0 && q.x() <= 2.4 && std::abs(q.y()) <= 2.0))
 		{
-			const Eigen::Vector3d w = R * Eigen::Vector3d(1.0, (K.cx - c) / K.fx, (K.cy - r) / K.fy);
-			if (w.z() >= 0) continue;
-			double t = (0.20 - camPos.z()) / w.z();  // the stage's top
-			Eigen::Vector3d q = camPos + t * w;
-			if (!(q.x() >= 1.0 && q.x() <= 2.4 && std::abs(q.y()) <= 2.0))
-			{
-				t = -camPos.z() / w.z();  // the floor, seen only past the stage
-				q = camPos + t * w;
-				if (q.x() < 2.4) continue;
-			}
-			if (t < 4.5) depth[size_t(r * K.width + c)] = uint16_t(std::lround(t * 1000));
+			t = -camPos.z() / w.z();  // the floor, seen only past the stage
+			q = camPos + t * w;
+			if (q.x() < 2.4) return -1.0;
 		}
-	SensorFrame frame;
-	frame.has_image = true;
-	frame.image.data = depth.data();
-	frame.image.rows = K.height;
-	frame.image.cols = K.width;
-	frame.image.stride = size_t(K.width);
-	frame.intrinsics = K;
-	frame.sensor_to_map.R = R.cast<float>();
-	frame.sensor_to_map.t = camPos.cast<float>();
-	frame.sensor_position = camPos;
+		return t < 4.5 ? t : -1.0;
+	});
+	const SensorFrame frame = gamtest::depthFrame(depth, K, R, camPos);
 
 	auto stageEvidence = [&](double limit, bool& fromMount) {
 		PipelineParams params;

@@ -8,13 +8,52 @@
 #include <random>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "gam/core/ElevationGrid.h"
+#include "gam/core/SensorFrame.h"
 
 namespace gamtest
 {
 inline constexpr double kPi = 3.14159265358979323846;
 inline double deg2rad(double d) { return d * kPi / 180.0; }
 inline double rad2deg(double r) { return r * 180.0 / kPi; }
+
+/** A depth image (mm, 0 = no return) of a camera at `camPos` with rotation `R`
+ * (sensor -> map, MRPT's sensor frame) and intrinsics K: `depthAlongX(w)`
+ * gives, for the unit-less pixel ray w (map frame, its sensor x = 1), the depth
+ * along the sensor's X, or a value <= 0 for no return. */
+inline std::vector<uint16_t> renderDepth(
+	const gam::PinholeIntrinsics& K, const Eigen::Matrix3d& R,
+	const std::function<double(const Eigen::Vector3d& w)>& depthAlongX)
+{
+	std::vector<uint16_t> depth(size_t(K.width * K.height), 0);
+	for (int r = 0; r < K.height; r++)
+		for (int c = 0; c < K.width; c++)
+		{
+			const double t = depthAlongX(R * Eigen::Vector3d(1.0, (K.cx - c) / K.fx, (K.cy - r) / K.fy));
+			if (t > 0 && std::isfinite(t)) depth[size_t(r * K.width + c)] = uint16_t(std::lround(t * 1000));
+		}
+	return depth;
+}
+
+/** The SensorFrame of such an image (it must outlive the frame). */
+inline gam::SensorFrame depthFrame(
+	const std::vector<uint16_t>& depth, const gam::PinholeIntrinsics& K, const Eigen::Matrix3d& R,
+	const Eigen::Vector3d& camPos)
+{
+	gam::SensorFrame frame;
+	frame.has_image = true;
+	frame.image.data = depth.data();
+	frame.image.rows = K.height;
+	frame.image.cols = K.width;
+	frame.image.stride = size_t(K.width);
+	frame.intrinsics = K;
+	frame.sensor_to_map.R = R.cast<float>();
+	frame.sensor_to_map.t = camPos.cast<float>();
+	frame.sensor_position = camPos;
+	return frame;
+}
 
 inline gam::GridGeometry makeGeometry(double x_min, double y_min, double res, int nx, int ny)
 {

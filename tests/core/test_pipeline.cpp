@@ -69,26 +69,11 @@ TEST(Pipeline, DepthImageOfFloorAndBoxToEvidence)
 	const Eigen::Matrix3d R = Eigen::AngleAxisd(deg2rad(25), Eigen::Vector3d::UnitY()).toRotationMatrix();
 	const Box box{{1.5, -0.2, 0.0}, {1.9, 0.2, 0.3}};
 
-	std::vector<uint16_t> depth(size_t(K.width * K.height), 0);
-	for (int r = 0; r < K.height; r++)
-		for (int c = 0; c < K.width; c++)
-		{
-			const Eigen::Vector3d ray(1.0, (K.cx - c) / K.fx, (K.cy - r) / K.fy);
-			const Eigen::Vector3d w = R * ray;
-			const double t = castRay(camPos, w, 0.0, {box});
-			// t is the depth along the sensor X axis since ray.x() = 1.
-			if (std::isfinite(t) && t < 4.5) depth[size_t(r * K.width + c)] = uint16_t(std::lround(t * 1000));
-		}
-	SensorFrame frame;
-	frame.has_image = true;
-	frame.image.data = depth.data();
-	frame.image.rows = K.height;
-	frame.image.cols = K.width;
-	frame.image.stride = size_t(K.width);
-	frame.intrinsics = K;
-	frame.sensor_to_map.R = R.cast<float>();
-	frame.sensor_to_map.t = camPos.cast<float>();
-	frame.sensor_position = camPos;
+	const std::vector<uint16_t> depth = gamtest::renderDepth(K, R, [&](const Eigen::Vector3d& w) {
+		const double t = castRay(camPos, w, 0.0, {box});
+		return t < 4.5 ? t : -1.0;  // t is the depth along the sensor X axis since ray.x() = 1
+	});
+	SensorFrame frame = gamtest::depthFrame(depth, K, R, camPos);
 
 	PipelineParams params;
 	params.m_x = params.m_y = 240;  // x, y in [-6, 6): everything the camera sees up to 4.5 m
