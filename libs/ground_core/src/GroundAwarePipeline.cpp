@@ -108,10 +108,27 @@ const FrameResult& GroundAwarePipeline::process(
 	resetResult();
 	const auto t0 = clk::now();
 
+	// The camera (not in the paper's model): its noise model, and whether
+	// its depth comes from disparity.
+	const bool paperIsm = m_params.ism.model == MethodVariant::Paper;
+	const CameraParams& cam = m_params.camera;
+	if (!paperIsm)
+		m_result.camera = cam.model != CameraModel::Auto ? cam.model
+														 : detectCameraModel(
+															   frame.sensor_label, frame.intrinsics.width,
+															   frame.intrinsics.height, frame.intrinsics.fx);
+	const CameraNoise noise = m_result.camera == CameraModel::Custom ? cam.custom : cameraNoisePreset(m_result.camera);
+
 	// 1. The robot-centred 2.5D map of this frame.
 	placeGrid(robot, lattice);
 	m_bins.clear();
-	m_result.samples = binSensorFrame(frame, m_params.projectionFilter(robot.z()), m_grid, m_projector, m_bins);
+	ProjectionFilter filter = m_params.projectionFilter(robot.z());
+	// Flying (mixed) pixels are a time-of-flight effect: a stereo or
+	// structured-light pixel matches one surface or none. On such cameras the
+	// filter only removes good edge pixels (D435 ablation: ramp false
+	// obstacles 8.7 -> 6.6 %, nothing else changed, half the time).
+	if (!paperIsm && noise.baseline > 0) filter.drop_flying_pixels = false;
+	m_result.samples = binSensorFrame(frame, filter, m_grid, m_projector, m_bins);
 	const auto t1 = clk::now();
 	m_result.points = m_grid.insert(m_bins, m_params.outlierFilter());
 	if (m_params.idw.radius_cells > 0)
@@ -141,17 +158,10 @@ const FrameResult& GroundAwarePipeline::process(
 	// 3. Evidence, within the range of trust of the camera.
 	m_result.sensor = frame.sensor_position;
 	double evidenceRange = m_params.projection.max_range;
-	if (m_params.ism.model != MethodVariant::Paper)
+	if (!paperIsm)
 	{
-		const CameraParams& cam = m_params.camera;
-		m_result.camera = cam.model != CameraModel::Auto ? cam.model
-														 : detectCameraModel(
-															   frame.sensor_label, frame.intrinsics.width,
-															   frame.intrinsics.height, frame.intrinsics.fx);
 		if (cam.range_of_trust && frame.has_image)
 		{
-			const CameraNoise noise =
-				m_result.camera == CameraModel::Custom ? cam.custom : cameraNoisePreset(m_result.camera);
 			m_result.trust_range = trustRange(
 				noise, frame.intrinsics.fx, frame.sensor_position.z() - robot.z(), lattice.resolution,
 				m_params.ism.noise_sigmas, m_params.ism.traversable_step, evidenceRange);
