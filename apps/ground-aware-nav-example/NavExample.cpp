@@ -34,9 +34,15 @@ mrpt::poses::CPose3D toCPose3D(const gam::sim::Pose3& p)
 mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
 	const gam::sim::SceneFile& sf, const gam::sim::Pose2& robot, std::mt19937& rng)
 {
+	return simulateKinect(sf, sf.scene, robot, rng);
+}
+
+mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
+	const gam::sim::SceneFile& sf, const gam::sim::Scene& scene, const gam::sim::Pose2& robot, std::mt19937& rng)
+{
 	const gam::sim::KinectModel kinect(sf.kinect);
 	const gam::sim::Pose3 robot3 = gam::sim::Pose3::fromXYZYPR(robot.x, robot.y, 0, robot.yaw, 0, 0);
-	const gam::sim::DepthFrame fr = kinect.render(sf.scene, robot3 * sf.kinect_pose, rng);
+	const gam::sim::DepthFrame fr = kinect.render(scene, robot3 * sf.kinect_pose, rng);
 
 	return gam::sim::toKinectObservation(sf.kinect, fr, toCPose3D(sf.kinect_pose));
 }
@@ -300,20 +306,25 @@ ClosedLoopResult runClosedLoopNavigation(
 	};
 	r.trajectory.push_back(sim.getCurrentGTPose());
 	bool navigating = false;
+	const bool moving = sf.scene.dynamic();
+	gam::sim::Scene frameScene;
 	for (double t = 0; t < ro.maxTime; t += ro.dt)
 	{
 		const mrpt::math::TPose2D gt = sim.getCurrentGTPose(), known = robot.believedPose();
 		if (t >= nextFrame)
 		{
-			// Rendered where the robot is, inserted where it believes it is.
-			const auto obs = simulateKinect(sf, gam::sim::Pose2{gt.x, gt.y, gt.phi}, rng);
+			// Frame k of the scene (people move per frame), rendered where the robot
+			// is, inserted where it believes it is.
+			if (moving) frameScene = sf.scene.atFrame(int(r.frames));
+			const gam::sim::Scene& scene = moving ? frameScene : sf.scene;
+			const auto obs = simulateKinect(sf, scene, gam::sim::Pose2{gt.x, gt.y, gt.phi}, rng);
 			const mrpt::poses::CPose3D believed(known.x, known.y, 0, known.phi, 0, 0);
 			grid.insertObservation(*obs, believed);
 			if (sf.leddar_enabled)
 			{
 				// The walker's Leddar, in the same step (the grid's own rule for 2D scans).
 				const gam::sim::Pose3 robot3 = gam::sim::Pose3::fromXYZYPR(gt.x, gt.y, 0, gt.phi, 0, 0);
-				const gam::sim::LeddarScan ls = leddar.scan(sf.scene, robot3 * sf.leddar_pose, rng);
+				const gam::sim::LeddarScan ls = leddar.scan(scene, robot3 * sf.leddar_pose, rng);
 				grid.insertObservation(
 					*gam::sim::toLeddarObservation(sf.leddar, ls, toCPose3D(sf.leddar_pose)), believed);
 				r.leddarScans++;
@@ -360,6 +371,11 @@ ClosedLoopResult runClosedLoopNavigation(
 		}
 		r.trajectory.push_back(sim.getCurrentGTPose());
 		r.seconds = t + ro.dt;
+		if (opts.onStep && !opts.onStep(r.seconds, r.trajectory.back()))
+		{
+			r.stoppedByCallback = true;
+			break;
+		}
 		if (navigating && nav->getWaypointNavStatus().final_goal_reached) break;
 		if (navigating && nav->getCurrentState() == mrpt::nav::CAbstractNavigator::NAV_ERROR) break;
 	}

@@ -21,6 +21,7 @@
 #include <mrpt/poses/CPose3D.h>
 
 #include <deque>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -34,6 +35,10 @@ namespace gam::nav
  * +X, the scene's sensor pose and intrinsics). `sensorNoise` false = exact. */
 mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
 	const gam::sim::SceneFile& sf, const gam::sim::Pose2& robot, std::mt19937& rng);
+/** The same in `scene` (e.g. sf.scene.atFrame(f): the people where they are
+ * then), with sf's camera. */
+mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
+	const gam::sim::SceneFile& sf, const gam::sim::Scene& scene, const gam::sim::Pose2& robot, std::mt19937& rng);
 
 /** The two grids of one mapping run over the scene's path. */
 struct NavMaps
@@ -143,19 +148,26 @@ struct ClosedLoopOptions
 	 * arrival) is the true one. 0, 0 = exact odometry. */
 	double odometryScaleError = 0;
 	double odometryYawDriftDegPerM = 0;
+	/** Called after every simulation step with the simulated time and the
+	 * robot's TRUE pose; returning false ends the run there (a benchmark's
+	 * fall, collision or no progress). */
+	std::function<bool(double t, const mrpt::math::TPose2D& truePose)> onStep;
 };
 
 struct ClosedLoopResult : ReactiveResult
 {
-	size_t frames = 0;              ///< depth frames rendered and inserted
-	size_t leddarScans = 0;         ///< Leddar scans (one with each depth frame if the scene has a Leddar)
-	int plans = 0;                  ///< global plans computed (the first and the replans)
-	double finalOdometryError = 0;  ///< |odometry - true| at the end [m]
+	size_t frames = 0;               ///< depth frames rendered and inserted
+	size_t leddarScans = 0;          ///< Leddar scans (one with each depth frame if the scene has a Leddar)
+	int plans = 0;                   ///< global plans computed (the first and the replans)
+	double finalOdometryError = 0;   ///< |odometry - true| at the end [m]
+	bool stoppedByCallback = false;  ///< opts.onStep returned false
 };
 
 /** Issue #29, closed loop: the walker maps while it drives. Every
  * frameInterval the scene's Kinect renders a depth frame at the robot's true
- * pose, with the scene's Leddar scan if it has one, and `grid` (a fresh or
+ * pose (frame k at time k * frameInterval, in the scene as it is in its frame
+ * k: Scene::atFrame, so that people cross as the scene file makes them),
+ * with the scene's Leddar scan if it has one, and `grid` (a fresh or
  * stock-started grid; it is updated) inserts them
  * at the odometry pose (exact unless opts sets a drift). PlannerSimple2D plans on the current
  * grid from the robot to `goal`; CReactiveNavigationSystem follows that plan

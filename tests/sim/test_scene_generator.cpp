@@ -98,8 +98,8 @@ TEST(SceneGenerator, DropKindsAreDropCellsAndObstacleKindsObstacleCells)
 {
 	// seeds 1..7 put, in turn, outlet, step_down, stairwell, cable_protector,
 	// small_box, table, hole on the line (seed % 7)
-	const HazardKind kinds[7] = {HazardKind::Hole,           HazardKind::Outlet,   HazardKind::StepDown,
-								 HazardKind::Stairwell,      HazardKind::CableProtector, HazardKind::SmallBox,
+	const HazardKind kinds[7] = {HazardKind::Hole,      HazardKind::Outlet,         HazardKind::StepDown,
+								 HazardKind::Stairwell, HazardKind::CableProtector, HazardKind::SmallBox,
 								 HazardKind::Table};
 	for (unsigned seed = 1; seed <= 7; seed++)
 	{

@@ -71,6 +71,7 @@ struct Layout
 	int nextId = 1;
 	HazardKind lineKind = HazardKind::Hole;
 	int lineId = 0;
+	bool ok = true;  ///< false: a passage of the line hazard is a trap (below)
 	bool clear(const Eigen::AlignedBox2d& b) const
 	{
 		for (const auto& t : taken)
@@ -99,8 +100,8 @@ void addWall(Layout& lay, const char* name, double xa, double ya, double xb, dou
 {
 	const int id = lay.nextId++;
 	lay.walls.push_back(id);
-	lay.lines.push_back(fmt(
-		"wall id=%d name=%s x0=%.3f y0=%.3f x1=%.3f y1=%.3f thickness=0.10 height=2.5", id, name, xa, ya, xb, yb));
+	lay.lines.push_back(
+		fmt("wall id=%d name=%s x0=%.3f y0=%.3f x1=%.3f y1=%.3f thickness=0.10 height=2.5", id, name, xa, ya, xb, yb));
 }
 
 int addHazard(Layout& lay, HazardKind k, bool onLine, const std::string& statement)
@@ -130,16 +131,14 @@ std::string freeHazard(Rand& r, HazardKind k, double cx, double cy, Eigen::Vecto
 	};
 	switch (k)
 	{
-		case HazardKind::Hole:
-		{
+		case HazardKind::Hole: {
 			const double sx = r.u(0.4, 0.8), sy = r.u(0.4, 0.8), yaw = r.u(-30, 30), d = r.u(0.2, 0.6);
 			aabb(sx, sy, yaw);
 			return fmt(
 				"hole id=%%ID%% name=hole shape=rect x=%.3f y=%.3f sx=%.3f sy=%.3f yaw=%.1f depth=%.3f", cx, cy, sx, sy,
 				yaw, d);
 		}
-		case HazardKind::Outlet:
-		{
+		case HazardKind::Outlet: {
 			const double sx = r.u(0.08, 0.25), sy = r.u(0.08, 0.20), yaw = r.u(-45, 45), d = r.u(0.05, 0.10);
 			aabb(sx, sy, yaw);
 			if (r.coin(0.3))
@@ -153,23 +152,20 @@ std::string freeHazard(Rand& r, HazardKind k, double cx, double cy, Eigen::Vecto
 				"hole id=%%ID%% name=outlet shape=rect x=%.3f y=%.3f sx=%.3f sy=%.3f yaw=%.1f depth=%.3f", cx, cy, sx,
 				sy, yaw, d);
 		}
-		case HazardKind::SmallBox:
-		{
+		case HazardKind::SmallBox: {
 			const double sx = r.u(0.08, 0.25), sy = r.u(0.08, 0.25), sz = r.u(0.05, 0.15), yaw = r.u(-45, 45);
 			aabb(sx, sy, yaw);
 			return fmt(
 				"box id=%%ID%% name=small_box x=%.3f y=%.3f sx=%.3f sy=%.3f sz=%.3f yaw=%.1f", cx, cy, sx, sy, sz, yaw);
 		}
-		case HazardKind::Table:
-		{
+		case HazardKind::Table: {
 			const double sx = r.u(0.6, 1.0), sy = r.u(0.6, 1.0), h = r.u(0.45, 0.75), yaw = r.u(-20, 20);
 			aabb(sx, sy, yaw);
 			return fmt(
 				"table id=%%ID%% name=table x=%.3f y=%.3f yaw=%.1f sx=%.3f sy=%.3f height=%.3f top=0.04 leg=0.05", cx,
 				cy, yaw, sx, sy, h);
 		}
-		case HazardKind::CableProtector:
-		{
+		case HazardKind::CableProtector: {
 			// free-standing: a short one (a cable across part of the floor)
 			const double sx = r.u(0.2, 0.3), sy = r.u(0.6, 1.2), sz = r.u(0.03, 0.05), yaw = r.u(-30, 30);
 			aabb(sx, sy, yaw);
@@ -177,8 +173,7 @@ std::string freeHazard(Rand& r, HazardKind k, double cx, double cy, Eigen::Vecto
 				"box id=%%ID%% name=cable_protector x=%.3f y=%.3f sx=%.3f sy=%.3f sz=%.3f yaw=%.1f", cx, cy, sx, sy, sz,
 				yaw);
 		}
-		case HazardKind::Ramp:
-		{
+		case HazardKind::Ramp: {
 			// up, plateau, down: centred on (cx, cy) along yaw
 			const double len = r.u(0.6, 1.0), w = r.u(0.8, 1.2), ang = r.u(3, 6), plat = r.u(0.3, 0.6);
 			const double yaw = r.coin() ? r.u(-20, 20) : 90 + r.u(-20, 20);
@@ -237,8 +232,8 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 	lay.taken.push_back(boxAround(lay.goal.x(), lay.goal.y(), 0.9, 0.9));
 
 	// The hazard on the straight line: the kinds cycle with the seed.
-	const HazardKind lineKinds[] = {HazardKind::Hole,           HazardKind::Outlet,   HazardKind::StepDown,
-									HazardKind::Stairwell,      HazardKind::CableProtector, HazardKind::SmallBox,
+	const HazardKind lineKinds[] = {HazardKind::Hole,      HazardKind::Outlet,         HazardKind::StepDown,
+									HazardKind::Stairwell, HazardKind::CableProtector, HazardKind::SmallBox,
 									HazardKind::Table};
 	const HazardKind k = lineKinds[seed % 7];
 	const double s = r.u(0.40, 0.60);
@@ -253,8 +248,7 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 	Eigen::Vector2d half(0, 0);
 	switch (k)
 	{
-		case HazardKind::StepDown:
-		{
+		case HazardKind::StepDown: {
 			const double sx = r.u(0.8, 1.4), sy = std::abs(wallAtP - edge) + 0.05, d = r.u(0.10, 0.20);
 			lay.lineId = addHazard(
 				lay, k, true,
@@ -263,8 +257,7 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 			lay.taken.push_back(boxAround(P.x(), (wallAtP + edge) / 2, sx / 2 + 0.4, sy / 2 + 0.4));
 			break;
 		}
-		case HazardKind::Stairwell:
-		{
+		case HazardKind::Stairwell: {
 			// descends from its top edge (at `edge`) towards the wall; the landing fills the rest
 			const int steps = 2 + r.i(3);
 			const double run = 0.28, rise = r.u(0.15, 0.18), w = r.u(0.9, 1.2);
@@ -277,8 +270,7 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 			lay.taken.push_back(boxAround(P.x(), (wallAtP + edge) / 2, w / 2 + 0.4, len / 2 + 0.4));
 			break;
 		}
-		case HazardKind::CableProtector:
-		{
+		case HazardKind::CableProtector: {
 			const double sx = r.u(0.2, 0.3), sy = std::abs(wallAtP - edge), sz = r.u(0.03, 0.05), yaw = r.u(-8, 8);
 			lay.lineId = addHazard(
 				lay, k, true,
@@ -287,13 +279,20 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 			lay.taken.push_back(boxAround(P.x(), (wallAtP + edge) / 2, sx / 2 + 0.4, sy / 2 + 0.4));
 			break;
 		}
-		default:
-		{
+		default: {
 			// free-standing, centred within a few cm of the line (the outlet exactly on it)
 			const double off = k == HazardKind::Outlet ? 0.0 : r.u(-0.1, 0.1);
 			const std::string st = freeHazard(r, k, P.x(), P.y() + off, half);
 			lay.lineId = addHazard(lay, k, true, st);
-			lay.taken.push_back(boxAround(P.x(), P.y() + off, half.x() + 0.4, half.y() + 0.4));
+			lay.taken.push_back(boxAround(P.x(), P.y() + off, half.x() + 0.5, half.y() + 0.5));
+			// Passages beside it: closed (< 0.15 m) or at least 0.9 m wide. One of
+			// 0.6-0.9 m lets the planner's 0.30 m radius through on the ground truth
+			// and closes as the noisy map's edges grow: a trap that tests squeezing
+			// through, not seeing the hazard. Such a layout is drawn again.
+			const double top = std::min(c.yTop(P.x() - half.x()), c.yTop(P.x() + half.x()));
+			const double bot = std::max(c.yBot(P.x() - half.x()), c.yBot(P.x() + half.x()));
+			for (const double gap : {top - (P.y() + off + half.y()), (P.y() + off - half.y()) - bot})
+				if (gap > 0.15 && gap < 0.9) lay.ok = false;
 			break;
 		}
 	}
@@ -308,14 +307,25 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 	for (const HazardKind e : extra)
 		for (int tries = 0; tries < 40; tries++)
 		{
+			// against a wall (half of them) or at least 0.9 m from both walls, and
+			// 0.9-1.0 m from the other hazards: no passage narrower than 0.9 m
 			const double x = r.u(0.8, c.L - 0.3);
-			const double y = r.u(c.yBot(x) + 0.4, c.yTop(x) - 0.4);
+			const bool againstWall = r.coin(), top = r.coin();
+			double y = r.u(c.yBot(x) + 0.4, c.yTop(x) - 0.4);
 			Rand probe = r;  // the size first, the same draw if the place is kept
 			Eigen::Vector2d hs;
-			const std::string st = freeHazard(probe, e, x, y, hs);
-			const Eigen::AlignedBox2d b = boxAround(x, y, hs.x() + 0.3, hs.y() + 0.3);
-			const bool inside = y - hs.y() > std::max(c.yBot(x - hs.x()), c.yBot(x + hs.x())) + 0.05 &&
-								y + hs.y() < std::min(c.yTop(x - hs.x()), c.yTop(x + hs.x())) - 0.05;
+			std::string st = freeHazard(probe, e, x, y, hs);
+			const double yTop = std::min(c.yTop(x - hs.x()), c.yTop(x + hs.x()));
+			const double yBot = std::max(c.yBot(x - hs.x()), c.yBot(x + hs.x()));
+			if (againstWall)
+			{
+				y = top ? yTop - 0.05 - hs.y() : yBot + 0.05 + hs.y();
+				probe = r;
+				st = freeHazard(probe, e, x, y, hs);
+			}
+			const Eigen::AlignedBox2d b = boxAround(x, y, hs.x() + 0.5, hs.y() + 0.5);
+			const bool inside = againstWall ? y - hs.y() > yBot && y + hs.y() < yTop
+											: y - hs.y() > yBot + 0.9 && y + hs.y() < yTop - 0.9;
 			if (!lay.clear(b) || !inside) continue;
 			r = probe;
 			addHazard(lay, e, false, st);
@@ -323,17 +333,27 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 			break;
 		}
 
-	// 0-2 people crossing the corridor (present only while crossing, then gone
-	// through a door in the wall), each in its own 2-12 s window.
+	// 0-2 people crossing the corridor AHEAD of the walker (present only while
+	// crossing, then gone through a door in the wall). The walker drives at most
+	// 0.5 m/s (the nav example's maxSpeed), so by time t its centre is at most
+	// 0.5 t along x from the start (x = 0). A crossing at x_p ends by the time the
+	// walker could be 1.4 m short of x_p (its footprint reaches 0.36 m ahead, the
+	// person 0.2 m back: 0.84 m to spare) and starts at most 4 s earlier than the
+	// walker could be 3 m short of it: the camera sees the person cross and leave
+	// its trail on the floor, the test is the map's (issue #14), and a person
+	// never walks into the walker's side, which no map could avoid.
 	for (int n = r.i(3); n > 0; n--)
 	{
-		const double x = r.u(1.2, c.L - 0.3);
+		const double x = r.u(3.0, c.L - 0.3);
 		const bool down = r.coin();
 		const double yA = c.yTop(x) - 0.3, yB = c.yBot(x) + 0.3;
 		const double y0 = down ? yA : yB, y1 = down ? yB : yA;
 		const double speed = r.u(0.8, 1.3);
-		const int f0 = 20 + r.i(100);
-		const int f1 = f0 + std::max(1, int(std::lround(std::abs(y1 - y0) / (speed * 0.1))));
+		const double D = std::abs(y1 - y0) / speed;  // crossing time [s]
+		const double latestEnd = (x - 1.4) / 0.5, earliestEnd = std::max(D + 0.5, (x - 3.0) / 0.5 - 4.0 + D);
+		if (latestEnd < earliestEnd) continue;
+		const double tEnd = r.u(earliestEnd, latestEnd);
+		const int f1 = int(std::floor(tEnd * 10)), f0 = std::max(1, f1 - int(std::ceil(D * 10)));
 		addHazard(
 			lay, HazardKind::Person, false,
 			fmt("box id=%%ID%% name=person x=%.3f y=%.3f sx=0.40 sy=0.30 sz=1.70 frames=%d-%d to=%.3f,%.3f "
@@ -481,10 +501,12 @@ GeneratedScene generateScene(unsigned seed, const GeneratorOptions& opts)
 	{
 		Corridor c;
 		Layout lay = drawLayout(r, seed, c);
+		if (!lay.ok) continue;
 		const double yMin = -c.W / 2 - c.eBot, yMax = c.W / 2 + c.eTop;
 		const double res = opts.resolution;
-		const bool people = std::any_of(
-			lay.hazards.begin(), lay.hazards.end(), [](const GeneratedHazard& h) { return h.kind == HazardKind::Person; });
+		const bool people = std::any_of(lay.hazards.begin(), lay.hazards.end(), [](const GeneratedHazard& h) {
+			return h.kind == HazardKind::Person;
+		});
 
 		std::ostringstream t;
 		t << "# generated by gam::sim::generateScene(seed=" << seed << "), layout " << attempt << " of its stream\n";

@@ -6,8 +6,9 @@
 // a floor outlet, a downward step, a stairwell, a cable protector, a small box
 // or a table, cycling with the seed so that any 7 consecutive seeds have each
 // kind once), 1-3 further hazards and ramps elsewhere, and 0-2 people who
-// cross the corridor (moving boxes, the scene model's `frames=` / `to=` motion)
-// and leave. A layout is kept only if the straight start-goal line meets a
+// cross the corridor ahead of the walker (moving boxes, the scene model's
+// `frames=` / `to=` motion), timed so that a walker of at most 0.5 m/s sees
+// them cross and leave but cannot meet them. A layout is kept only if the straight start-goal line meets a
 // hazard and a path exists around it on the ground truth (obstacle and drop
 // cells grown by the walker's radius, people left out: they move); otherwise
 // the next layout of the same random stream is drawn. The scene is made as
@@ -51,8 +52,9 @@ struct GeneratedHazard
 struct GeneratorOptions
 {
 	/** The path check grows the ground truth's obstacle and drop cells by this
-	 * [m]: the nav example's planner radius (PlanOptions::robotRadius). */
-	double walkerRadius = 0.30;
+	 * [m]: the nav example's planner radius (PlanOptions::robotRadius, 0.30 m)
+	 * plus 0.10 m, so the way around is at least 0.8 m wide. */
+	double walkerRadius = 0.40;
 	double resolution = 0.05;  ///< ground-truth cell [m]
 	int maxAttempts = 200;     ///< layouts drawn before giving up (throws)
 };
