@@ -117,6 +117,7 @@ RunResult runOne(const gam::sim::GeneratedScene& g, const std::string& map, cons
 	co.reactive.baseConfig = o.reactiveConfig;
 	co.reactive.cacheDir = o.cacheDir;
 	co.reactive.maxTime = o.timeBase + o.timePerMetre * g.gtPathLength;
+	co.plan.robotRadius = float(o.planRadius);
 	co.seed = g.seed;  // sensor noise: the same frames for every map while they drive the same way
 	const double half = co.reactive.robotHalfSize;
 
@@ -162,13 +163,29 @@ RunResult runOne(const gam::sim::GeneratedScene& g, const std::string& map, cons
 	const auto r =
 		gam::nav::runClosedLoopNavigation(sf, *bm->grid, start, mrpt::math::TPoint2D(g.goal.x(), g.goal.y()), co);
 
+	if (!o.mapPictureDir.empty())
+	{
+		std::ofstream tf(o.mapPictureDir + "/seed_" + std::to_string(g.seed) + "_" + map + "_trajectory.csv");
+		tf << "t,x,y,phi\n";
+		for (size_t i = 0; i < r.trajectory.size(); i++)
+			tf << i * co.reactive.dt << "," << r.trajectory[i].x << "," << r.trajectory[i].y << ","
+			   << r.trajectory[i].phi << "\n";
+		gam::nav::PlanResult traj;
+		for (const auto& p : r.trajectory) traj.path.emplace_back(p.x, p.y);
+		gam::nav::savePathPicture(
+			*bm->grid, traj, {g.start.x(), g.start.y()}, {g.goal.x(), g.goal.y()},
+			o.mapPictureDir + "/seed_" + std::to_string(g.seed) + "_" + map + ".png");
+	}
 	res.trajectory = r.trajectory;
 	res.seconds = r.seconds;
 	res.frames = r.frames;
 	res.plans = r.plans;
+	res.failedPlans = r.failedPlans;
+	res.turningSeconds = r.turningSeconds;
 	res.endState = r.endState;
 	for (size_t i = 1; i < r.trajectory.size(); i++)
-		res.pathLength += std::hypot(r.trajectory[i].x - r.trajectory[i - 1].x, r.trajectory[i].y - r.trajectory[i - 1].y);
+		res.pathLength +=
+			std::hypot(r.trajectory[i].x - r.trajectory[i - 1].x, r.trajectory[i].y - r.trajectory[i - 1].y);
 	const auto& e = r.trajectory.back();
 	res.finalDistance = std::hypot(e.x - g.goal.x(), e.y - g.goal.y());
 	if (res.fell)
@@ -230,7 +247,7 @@ std::string markdownTable(const std::vector<RunResult>& runs, const std::vector<
 std::string csvHeader()
 {
 	return "seed,map,outcome,arrived,fall,collision,stuck,timeout,time_s,path_m,final_distance_m,gt_path_m,"
-		   "line_hazard,hit_object,hit_name,frames,plans,end_state,wall_s\n";
+		   "line_hazard,hit_object,hit_name,frames,plans,failed_plans,turning_s,end_state,wall_s\n";
 }
 
 std::string csvRow(const RunResult& r)
@@ -239,7 +256,8 @@ std::string csvRow(const RunResult& r)
 	s << r.seed << "," << r.map << "," << r.outcome << "," << r.arrived << "," << r.fell << "," << r.collided << ","
 	  << r.stuck << "," << r.timedOut << "," << std::fixed << std::setprecision(2) << r.seconds << "," << r.pathLength
 	  << "," << r.finalDistance << "," << r.gtPathLength << "," << r.lineHazard << "," << r.hitObject << ","
-	  << r.hitName << "," << r.frames << "," << r.plans << "," << r.endState << "," << r.wallSeconds << "\n";
+	  << r.hitName << "," << r.frames << "," << r.plans << "," << r.failedPlans << "," << r.turningSeconds << ","
+	  << r.endState << "," << r.wallSeconds << "\n";
 	return s.str();
 }
 
@@ -297,7 +315,9 @@ void drawTrajectories(
 		im.textOut(gap, oy + 13, u.str(), mrpt::img::TColor(0, 0, 0));
 		oy += label;
 		auto px = [&](double x) { return gap + int(std::lround((x - gt.spec.min_x) / gt.spec.resolution * scale)); };
-		auto py = [&](double y) { return oy + ny * scale - 1 - int(std::lround((y - gt.spec.min_y) / gt.spec.resolution * scale)); };
+		auto py = [&](double y) {
+			return oy + ny * scale - 1 - int(std::lround((y - gt.spec.min_y) / gt.spec.resolution * scale));
+		};
 		for (int iy = 0; iy < ny; iy++)
 			for (int ix = 0; ix < nx; ix++)
 			{
@@ -312,9 +332,12 @@ void drawTrajectories(
 		for (const auto& ob : g.file.scene.objects)
 		{
 			if (!ob.dynamic()) continue;
-			const auto a = g.file.scene.footprintAt(ob.id, ob.first_frame), b = g.file.scene.footprintAt(ob.id, ob.last_frame);
+			const auto a = g.file.scene.footprintAt(ob.id, ob.first_frame),
+					   b = g.file.scene.footprintAt(ob.id, ob.last_frame);
 			if (a.isEmpty() || b.isEmpty()) continue;
-			im.line(px(a.center().x()), py(a.center().y()), px(b.center().x()), py(b.center().y()), mrpt::img::TColor(150, 150, 150), 3);
+			im.line(
+				px(a.center().x()), py(a.center().y()), px(b.center().x()), py(b.center().y()),
+				mrpt::img::TColor(150, 150, 150), 3);
 		}
 		for (size_t k = 0; k < maps.size(); k++)
 			for (const auto& r : runs)
@@ -396,11 +419,17 @@ std::string runNavBench(const NavBenchOptions& o, std::ostream& progress)
 	for (size_t i = 0; i < scenes.size(); i++)
 		for (const auto& m : o.maps) jobs.push_back({i, m});
 	std::vector<RunResult> results(jobs.size());
+	NavBenchOptions opts = o;
+	if (o.saveMaps)
+	{
+		opts.bench.mapPictureDir = o.outDir + "/maps";
+		fs::create_directories(opts.bench.mapPictureDir);
+	}
 	std::atomic<size_t> next{0}, done{0};
 	std::mutex mu;
 	std::exception_ptr failure;
 	auto worker = [&](int w) {
-		BenchOptions bo = o.bench;
+		BenchOptions bo = opts.bench;
 		// each worker its own PTG cache folder (the tables are written on first use)
 		bo.cacheDir = o.bench.cacheDir + "/navbench_ptg_w" + std::to_string(w);
 		fs::create_directories(bo.cacheDir);

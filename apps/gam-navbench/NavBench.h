@@ -74,11 +74,19 @@ struct BenchOptions
 	 * (the navigator's targetAllowedDistance 0.3 m plus 0.1 m, the closed
 	 * loop's own `reached` rule). */
 	double goalTolerance = 0.4;
-	double stuckSeconds = 15;   ///< no progress for this long = stuck [s]
-	double stuckProgress = 0.2; ///< progress = path distance to the goal down by this [m]
+	double stuckSeconds = 15;    ///< no progress for this long = stuck [s]
+	double stuckProgress = 0.2;  ///< progress = path distance to the goal down by this [m]
 	/** Time limit = timeBase + timePerMetre * the ground-truth path length
 	 * (6 s/m = three times the walker's 0.5 m/s). */
 	double timeBase = 30, timePerMetre = 6;
+	/** PlannerSimple2D's robot radius [m], the nav example's. (0.40 m, the
+	 * turning square's 0.354 m plus a cell, was tried: the planner then often
+	 * found the walker's own cell inside the grown noise of the map and no path.) */
+	double planRadius = 0.30;
+	/** If set: DIR/seed_<N>_<map>.png, the map at the end with the trajectory
+	 * (red), start (green) and goal (blue), and DIR/seed_<N>_<map>_trajectory.csv
+	 * (t, x, y, phi of the true pose every simulation step). */
+	std::string mapPictureDir;
 };
 
 struct RunResult
@@ -87,16 +95,17 @@ struct RunResult
 	std::string map;
 	std::string outcome;  ///< arrived, fall, collision, stuck, timeout
 	bool arrived = false, fell = false, collided = false, stuck = false, timedOut = false;
-	double seconds = 0;      ///< simulated time of the run [s]
-	double pathLength = 0;   ///< of the true trajectory [m]
-	double finalDistance = 0;///< true pose to goal at the end [m]
-	double gtPathLength = 0; ///< shortest ground-truth path (GeneratorOptions::walkerRadius 0.40 m) [m]
-	int hitObject = 0;       ///< the object fallen into or hit (0: none)
+	double seconds = 0;        ///< simulated time of the run [s]
+	double pathLength = 0;     ///< of the true trajectory [m]
+	double finalDistance = 0;  ///< true pose to goal at the end [m]
+	double gtPathLength = 0;   ///< shortest ground-truth path (GeneratorOptions::walkerRadius 0.45 m) [m]
+	int hitObject = 0;         ///< the object fallen into or hit (0: none)
 	std::string hitName;
 	std::string endState;  ///< the navigator's state at the end
 	std::string lineHazard;
 	size_t frames = 0;
-	int plans = 0;
+	int plans = 0, failedPlans = 0;
+	double turningSeconds = 0;
 	double wallSeconds = 0;
 	std::vector<mrpt::math::TPose2D> trajectory;
 };
@@ -130,9 +139,10 @@ struct NavBenchOptions
 	unsigned firstSeed = 1, lastSeed = 1;
 	std::vector<std::string> maps = mapNames();
 	std::string outDir;
-	int jobs = 1;          ///< runs in parallel (threads)
-	int figureScenes = 3;  ///< the first seeds drawn in trajectories.png
+	int jobs = 1;              ///< runs in parallel (threads)
+	int figureScenes = 3;      ///< the first seeds drawn in trajectories.png
 	bool writeScenes = false;  ///< DIR/scenes/seed_N.scene
+	bool saveMaps = false;     ///< DIR/maps/seed_N_<map>.png (BenchOptions::mapPictureDir)
 	BenchOptions bench;
 };
 

@@ -3,7 +3,7 @@
 // command line over gam::navbench::runNavBench (NavBench.h).
 //
 // usage: gam-navbench --seeds A-B --out DIR [--maps ground_aware,paper,height_band,octomap]
-//            [--jobs N] [--figure-scenes 3] [--write-scenes] [--reactive-config FILE]
+//            [--jobs N] [--figure-scenes 3] [--write-scenes] [--save-maps] [--reactive-config FILE]
 #include <gam/common/CommandLine.h>
 #include <gam/common/Version.h>
 #include <mrpt/3rdparty/tclap/CmdLine.h>
@@ -32,6 +32,8 @@ int main(int argc, char** argv)
 		TCLAP::ValueArg<int> argFigure(
 			"", "figure-scenes", "the first N seeds drawn in trajectories.png", false, 3, "N", cmd);
 		TCLAP::SwitchArg argWrite("", "write-scenes", "also write DIR/scenes/seed_N.scene", cmd);
+		TCLAP::SwitchArg argSaveMaps(
+			"", "save-maps", "also write DIR/maps/seed_N_MAP.png: each run's map at its end with the trajectory", cmd);
 		TCLAP::ValueArg<std::string> argReactiveCfg(
 			"", "reactive-config", "base reactive navigator .ini", false, gam::nav::ReactiveOptions{}.baseConfig,
 			"FILE", cmd);
@@ -57,6 +59,7 @@ int main(int argc, char** argv)
 		o.jobs = argJobs.getValue();
 		o.figureScenes = argFigure.getValue();
 		o.writeScenes = argWrite.getValue();
+		o.saveMaps = argSaveMaps.getValue();
 		o.bench.reactiveConfig = argReactiveCfg.getValue();
 		o.bench.cacheDir = std::filesystem::temp_directory_path().string();
 		const auto t0 = std::chrono::steady_clock::now();

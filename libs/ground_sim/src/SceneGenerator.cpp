@@ -175,7 +175,7 @@ std::string freeHazard(Rand& r, HazardKind k, double cx, double cy, Eigen::Vecto
 		}
 		case HazardKind::Ramp: {
 			// up, plateau, down: centred on (cx, cy) along yaw
-			const double len = r.u(0.6, 1.0), w = r.u(0.8, 1.2), ang = r.u(3, 6), plat = r.u(0.3, 0.6);
+			const double len = r.u(0.5, 0.8), w = r.u(0.7, 1.0), ang = r.u(3, 6), plat = r.u(0.2, 0.4);
 			const double yaw = r.coin() ? r.u(-20, 20) : 90 + r.u(-20, 20);
 			const double along = len + plat / 2;
 			aabb(2 * along, w, yaw);
@@ -193,7 +193,7 @@ std::string freeHazard(Rand& r, HazardKind k, double cx, double cy, Eigen::Vecto
 Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 {
 	Layout lay;
-	c.W = r.u(2.6, 3.4);
+	c.W = r.u(2.8, 3.6);
 	c.L = r.u(5.5, 7.0);
 	c.x0 = -1.0;
 	c.x1 = c.L + 1.0;
@@ -240,7 +240,8 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 	const Eigen::Vector2d P = lay.start + s * (lay.goal - lay.start);
 	lay.lineKind = k;
 	// the wall-attached kinds reach from the wall on the line's side to 0.25-0.4 m
-	// beyond the line: the way around is on the other side, >= 0.9 m wide
+	// beyond the line: the way around is on the other side, >= 1.0 m wide
+	// (W/2 >= 1.4, the edge at most 0.4 m past the line, |line y| <= 0.4 here)
 	const double side = P.y() >= 0 ? 1 : -1;
 	const double wallY = side * h;  // P.x is before the room or in it; the room widens it further
 	const double wallAtP = side > 0 ? c.yTop(P.x()) : c.yBot(P.x());
@@ -254,7 +255,7 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 				lay, k, true,
 				fmt("hole id=%%ID%% name=step_down shape=rect x=%.3f y=%.3f sx=%.3f sy=%.3f depth=%.3f", P.x(),
 					(wallAtP + edge) / 2, sx, sy, d));
-			lay.taken.push_back(boxAround(P.x(), (wallAtP + edge) / 2, sx / 2 + 0.4, sy / 2 + 0.4));
+			lay.taken.push_back(boxAround(P.x(), (wallAtP + edge) / 2, sx / 2 + 0.55, sy / 2 + 0.55));
 			break;
 		}
 		case HazardKind::Stairwell: {
@@ -267,7 +268,7 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 				fmt("stairs_down id=%%ID%% name=stairwell x=%.3f y=%.3f yaw=%.1f width=%.3f steps=%d rise=%.3f "
 					"run=%.3f landing=%.3f",
 					P.x(), edge, side * 90.0, w, steps, rise, run, landing));
-			lay.taken.push_back(boxAround(P.x(), (wallAtP + edge) / 2, w / 2 + 0.4, len / 2 + 0.4));
+			lay.taken.push_back(boxAround(P.x(), (wallAtP + edge) / 2, w / 2 + 0.55, len / 2 + 0.55));
 			break;
 		}
 		case HazardKind::CableProtector: {
@@ -276,7 +277,7 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 				lay, k, true,
 				fmt("box id=%%ID%% name=cable_protector x=%.3f y=%.3f sx=%.3f sy=%.3f sz=%.3f yaw=%.1f", P.x(),
 					(wallAtP + edge) / 2, sx, sy, sz, yaw));
-			lay.taken.push_back(boxAround(P.x(), (wallAtP + edge) / 2, sx / 2 + 0.4, sy / 2 + 0.4));
+			lay.taken.push_back(boxAround(P.x(), (wallAtP + edge) / 2, sx / 2 + 0.55, sy / 2 + 0.55));
 			break;
 		}
 		default: {
@@ -284,15 +285,15 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 			const double off = k == HazardKind::Outlet ? 0.0 : r.u(-0.1, 0.1);
 			const std::string st = freeHazard(r, k, P.x(), P.y() + off, half);
 			lay.lineId = addHazard(lay, k, true, st);
-			lay.taken.push_back(boxAround(P.x(), P.y() + off, half.x() + 0.5, half.y() + 0.5));
-			// Passages beside it: closed (< 0.15 m) or at least 0.9 m wide. One of
-			// 0.6-0.9 m lets the planner's 0.30 m radius through on the ground truth
-			// and closes as the noisy map's edges grow: a trap that tests squeezing
-			// through, not seeing the hazard. Such a layout is drawn again.
+			lay.taken.push_back(boxAround(P.x(), P.y() + off, half.x() + 0.55, half.y() + 0.55));
+			// Passages beside it: closed (< 0.15 m) or at least 1.1 m wide. A
+			// narrower one lets the planner's radius (0.30 m) through on the ground
+			// truth and closes as the noisy map's edges grow: a trap that tests
+			// squeezing through, not seeing the hazard. Such a layout is drawn again.
 			const double top = std::min(c.yTop(P.x() - half.x()), c.yTop(P.x() + half.x()));
 			const double bot = std::max(c.yBot(P.x() - half.x()), c.yBot(P.x() + half.x()));
 			for (const double gap : {top - (P.y() + off + half.y()), (P.y() + off - half.y()) - bot})
-				if (gap > 0.15 && gap < 0.9) lay.ok = false;
+				if (gap > 0.15 && gap < 1.1) lay.ok = false;
 			break;
 		}
 	}
@@ -305,10 +306,10 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 	for (int n = 1 + r.i(3); n > 0; n--) extra.push_back(others[r.i(6)]);
 	if (r.coin()) extra.push_back(HazardKind::Ramp);
 	for (const HazardKind e : extra)
-		for (int tries = 0; tries < 40; tries++)
+		for (int tries = 0; tries < 60; tries++)
 		{
-			// against a wall (half of them) or at least 0.9 m from both walls, and
-			// 0.9-1.0 m from the other hazards: no passage narrower than 0.9 m
+			// against a wall (half of them) or at least 1.1 m from both walls, and
+			// 1.1 m from the other hazards: no passage narrower than 1.1 m
 			const double x = r.u(0.8, c.L - 0.3);
 			const bool againstWall = r.coin(), top = r.coin();
 			double y = r.u(c.yBot(x) + 0.4, c.yTop(x) - 0.4);
@@ -323,9 +324,11 @@ Layout drawLayout(Rand& r, unsigned seed, Corridor& c)
 				probe = r;
 				st = freeHazard(probe, e, x, y, hs);
 			}
-			const Eigen::AlignedBox2d b = boxAround(x, y, hs.x() + 0.5, hs.y() + 0.5);
+			// (a ramp is traversable along its axis: 0.3 m around it is enough)
+			const double margin = e == HazardKind::Ramp ? 0.3 : 0.55;
+			const Eigen::AlignedBox2d b = boxAround(x, y, hs.x() + margin, hs.y() + margin);
 			const bool inside = againstWall ? y - hs.y() > yBot && y + hs.y() < yTop
-											: y - hs.y() > yBot + 0.9 && y + hs.y() < yTop - 0.9;
+											: y - hs.y() > yBot + 1.1 && y + hs.y() < yTop - 1.1;
 			if (!lay.clear(b) || !inside) continue;
 			r = probe;
 			addHazard(lay, e, false, st);

@@ -52,9 +52,10 @@ struct GeneratedHazard
 struct GeneratorOptions
 {
 	/** The path check grows the ground truth's obstacle and drop cells by this
-	 * [m]: the nav example's planner radius (PlanOptions::robotRadius, 0.30 m)
-	 * plus 0.10 m, so the way around is at least 0.8 m wide. */
-	double walkerRadius = 0.40;
+	 * [m]: the walker's 0.5 m square footprint turning (0.354 m) plus 0.1 m,
+	 * so the way around is at least 0.9 m wide (the nav example's planner
+	 * radius is 0.30 m). */
+	double walkerRadius = 0.45;
 	double resolution = 0.05;  ///< ground-truth cell [m]
 	int maxAttempts = 200;     ///< layouts drawn before giving up (throws)
 };
