@@ -425,6 +425,10 @@ std::string runNavBench(const NavBenchOptions& o, std::ostream& progress)
 		opts.bench.mapPictureDir = o.outDir + "/maps";
 		fs::create_directories(opts.bench.mapPictureDir);
 	}
+	// runs.csv grows run by run (in the order they end), so an interrupted
+	// benchmark keeps what it did; at the end it is written again in seed order.
+	std::ofstream partial(o.outDir + "/runs.csv");
+	partial << csvHeader() << std::flush;
 	std::atomic<size_t> next{0}, done{0};
 	std::mutex mu;
 	std::exception_ptr failure;
@@ -448,6 +452,7 @@ std::string runNavBench(const NavBenchOptions& o, std::ostream& progress)
 			}
 			const auto& r = results[j];
 			std::lock_guard<std::mutex> lk(mu);
+			partial << csvRow(r) << std::flush;
 			progress << "[gam-navbench " << ++done << "/" << jobs.size() << "] seed " << r.seed << " " << r.map << ": "
 					 << r.outcome;
 			if (r.hitObject) progress << " (" << r.hitName << ", id " << r.hitObject << ")";
@@ -461,6 +466,7 @@ std::string runNavBench(const NavBenchOptions& o, std::ostream& progress)
 	worker(0);
 	for (auto& t : threads) t.join();
 	if (failure) std::rethrow_exception(failure);
+	partial.close();
 
 	std::ofstream csv(o.outDir + "/runs.csv");
 	csv << csvHeader();
