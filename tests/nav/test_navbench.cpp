@@ -217,11 +217,13 @@ TEST(NavBenchTool, SmokeThreeRunsTableAndFiles)
 	// one progress line per run (stderr), then the table (stdout)
 	EXPECT_NE(out.find("[gam-navbench 3/3] seed "), std::string::npos) << out;
 	const std::regex header(
-		"\\| map \\| arrivals \\| falls \\| collisions \\| stuck \\| median time to goal \\[s\\] \\| median path \\[m\\] "
+		"\\| map \\| arrivals \\| falls \\| collisions \\| stuck \\| median time to goal \\[s\\] \\| median path "
+		"\\[m\\] "
 		"\\|\n\\|---\\|---\\|---\\|---\\|---\\|---\\|---\\|\n");
 	EXPECT_TRUE(std::regex_search(out, header)) << out;
 	std::smatch m;
-	const std::regex row("\\| ground_aware \\| (\\d+)/(\\d+) \\| (\\d+) \\| (\\d+) \\| (\\d+) \\| ([0-9.]+|-) \\| ([0-9.]+|-) \\|");
+	const std::regex row(
+		"\\| ground_aware \\| (\\d+)/(\\d+) \\| (\\d+) \\| (\\d+) \\| (\\d+) \\| ([0-9.]+|-) \\| ([0-9.]+|-) \\|");
 	ASSERT_TRUE(std::regex_search(out, m, row)) << out;
 	EXPECT_EQ(m[2].str(), "3") << "3 runs counted";
 	const int arrivals = std::stoi(m[1]), falls = std::stoi(m[3]), coll = std::stoi(m[4]), stuck = std::stoi(m[5]);
