@@ -109,9 +109,9 @@ struct ReactiveOptions
 	double robotHalfSize = 0.25;    ///< square robot footprint, half side [m]
 	/** The navigator's shape is the footprint grown by this [m] (its obstacles
 	 * are cell centres, so the footprint may reach half a cell into an
-	 * occupied cell). 0: one 5 cm cell was tried on gam-navbench seeds 1-30
-	 * and left 7 of 30 ground-aware runs stuck in front of obstacles instead
-	 * of 2 (the navigator finds fewer admissible motions). */
+	 * occupied cell). 0: one 5 cm cell, tried on gam-navbench, left 7 of the
+	 * first 25 ground-aware runs stuck in front of obstacles (2 in seeds 1-30
+	 * without it): the navigator finds fewer admissible motions. */
 	double footprintMargin = 0;
 	double refDistance = 4.0;  ///< PTG range [m]
 	double maxSpeed = 0.5;     ///< [m/s]
