@@ -4,6 +4,7 @@
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/kinematics/CVehicleSimul_DiffDriven.h>
+#include <mrpt/math/wrap2pi.h>
 #include <mrpt/nav/planners/PlannerSimple2D.h>
 #include <mrpt/nav/reactive/CReactiveNavigationSystem.h>
 #include <mrpt/nav/reactive/CRobot2NavInterfaceForSimulator.h>
@@ -34,9 +35,15 @@ mrpt::poses::CPose3D toCPose3D(const gam::sim::Pose3& p)
 mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
 	const gam::sim::SceneFile& sf, const gam::sim::Pose2& robot, std::mt19937& rng)
 {
+	return simulateKinect(sf, sf.scene, robot, rng);
+}
+
+mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
+	const gam::sim::SceneFile& sf, const gam::sim::Scene& scene, const gam::sim::Pose2& robot, std::mt19937& rng)
+{
 	const gam::sim::KinectModel kinect(sf.kinect);
 	const gam::sim::Pose3 robot3 = gam::sim::Pose3::fromXYZYPR(robot.x, robot.y, 0, robot.yaw, 0, 0);
-	const gam::sim::DepthFrame fr = kinect.render(sf.scene, robot3 * sf.kinect_pose, rng);
+	const gam::sim::DepthFrame fr = kinect.render(scene, robot3 * sf.kinect_pose, rng);
 
 	return gam::sim::toKinectObservation(sf.kinect, fr, toCPose3D(sf.kinect_pose));
 }
@@ -199,7 +206,7 @@ mrpt::config::CConfigFileMemory navigatorConfig(const ReactiveOptions& opts)
 	std::stringstream text;
 	text << f.rdbuf();
 	mrpt::config::CConfigFileMemory cfg(text.str());
-	const double h = opts.robotHalfSize;
+	const double h = opts.robotHalfSize + opts.footprintMargin;
 	const std::string xs = mrpt::format("%f %f %f %f", -h, h, h, -h);
 	const std::string ys = mrpt::format("%f %f %f %f", h, h, -h, -h);
 	cfg.write("CAbstractPTGBasedReactive", "ptg_cache_files_directory", opts.cacheDir);
@@ -209,10 +216,34 @@ mrpt::config::CConfigFileMemory navigatorConfig(const ReactiveOptions& opts)
 	cfg.write("CReactiveNavigationSystem", "RobotModel_shape2D_xs", xs);
 	cfg.write("CReactiveNavigationSystem", "RobotModel_shape2D_ys", ys);
 	cfg.write("CReactiveNavigationSystem", "RobotModel_circular_shape_radius", h);
-	for (int i = 0; i < cfg.read_int("CReactiveNavigationSystem", "PTG_COUNT", 0); i++)
+	const std::string sec = "CReactiveNavigationSystem";
+	if (opts.forwardOnly)
 	{
-		cfg.write("CReactiveNavigationSystem", mrpt::format("PTG%d_refDistance", i), opts.refDistance);
-		cfg.write("CReactiveNavigationSystem", mrpt::format("PTG%d_v_max_mps", i), opts.maxSpeed);
+		// Renumber the PTGs whose K is not negative (K = -1: the reversing family)
+		// as PTG0, PTG1, ...; the loader reads PTG_COUNT of them.
+		std::vector<std::string> keys;
+		cfg.getAllKeys(sec, keys);
+		const int n = cfg.read_int(sec, "PTG_COUNT", 0);
+		int kept = 0;
+		std::vector<std::pair<std::string, std::string>> renamed;
+		for (int i = 0; i < n; i++)
+		{
+			if (cfg.read_double(sec, mrpt::format("PTG%d_K", i), 1.0) < 0) continue;
+			const std::string from = mrpt::format("PTG%d_", i), to = mrpt::format("PTG%d_", kept);
+			for (const auto& k : keys)
+				if (k.rfind(from, 0) == 0)
+					renamed.emplace_back(to + k.substr(from.size()), cfg.read_string(sec, k, ""));
+			kept++;
+		}
+		if (kept == 0)
+			throw std::runtime_error("the reactive navigator config " + opts.baseConfig + " has no forward PTG");
+		for (const auto& [k, v] : renamed) cfg.write(sec, k, v);
+		cfg.write(sec, "PTG_COUNT", kept);
+	}
+	for (int i = 0; i < cfg.read_int(sec, "PTG_COUNT", 0); i++)
+	{
+		cfg.write(sec, mrpt::format("PTG%d_refDistance", i), opts.refDistance);
+		cfg.write(sec, mrpt::format("PTG%d_v_max_mps", i), opts.maxSpeed);
 	}
 	return cfg;
 }
@@ -299,21 +330,26 @@ ClosedLoopResult runClosedLoopNavigation(
 		return false;
 	};
 	r.trajectory.push_back(sim.getCurrentGTPose());
-	bool navigating = false;
+	bool navigating = false, noPath = false, turning = false;
+	const bool moving = sf.scene.dynamic();
+	gam::sim::Scene frameScene;
 	for (double t = 0; t < ro.maxTime; t += ro.dt)
 	{
 		const mrpt::math::TPose2D gt = sim.getCurrentGTPose(), known = robot.believedPose();
 		if (t >= nextFrame)
 		{
-			// Rendered where the robot is, inserted where it believes it is.
-			const auto obs = simulateKinect(sf, gam::sim::Pose2{gt.x, gt.y, gt.phi}, rng);
+			// Frame k of the scene (people move per frame), rendered where the robot
+			// is, inserted where it believes it is.
+			if (moving) frameScene = sf.scene.atFrame(int(r.frames));
+			const gam::sim::Scene& scene = moving ? frameScene : sf.scene;
+			const auto obs = simulateKinect(sf, scene, gam::sim::Pose2{gt.x, gt.y, gt.phi}, rng);
 			const mrpt::poses::CPose3D believed(known.x, known.y, 0, known.phi, 0, 0);
 			grid.insertObservation(*obs, believed);
 			if (sf.leddar_enabled)
 			{
 				// The walker's Leddar, in the same step (the grid's own rule for 2D scans).
 				const gam::sim::Pose3 robot3 = gam::sim::Pose3::fromXYZYPR(gt.x, gt.y, 0, gt.phi, 0, 0);
-				const gam::sim::LeddarScan ls = leddar.scan(sf.scene, robot3 * sf.leddar_pose, rng);
+				const gam::sim::LeddarScan ls = leddar.scan(scene, robot3 * sf.leddar_pose, rng);
 				grid.insertObservation(
 					*gam::sim::toLeddarObservation(sf.leddar, ls, toCPose3D(sf.leddar_pose)), believed);
 				r.leddarScans++;
@@ -321,10 +357,16 @@ ClosedLoopResult runClosedLoopNavigation(
 			r.frames++;
 			nextFrame += opts.frameInterval;
 		}
-		if (t >= nextPlan || (navigating && planBlocked()))
+		if (t >= nextPlan || (navigating && !noPath && planBlocked()))
 		{
 			const PlanResult p = planPath(grid, {known.x, known.y}, goal, opts.plan);
 			nextPlan = t + opts.replanInterval;
+			noPath = !p.found;
+			if (!p.found)
+			{
+				r.failedPlans++;
+				if (opts.turnInPlace) nextPlan = t + 0.5;  // look again after a few degrees of turning
+			}
 			if (p.found)
 			{
 				plan = p;
@@ -346,7 +388,50 @@ ClosedLoopResult runClosedLoopNavigation(
 				navigating = true;
 			}
 		}
-		nav->navigationStep();
+		// Look before driving: turn in place towards the plan, or to look around
+		// when there is no plan; otherwise the navigator drives.
+		double turn = 0;
+		if (opts.turnInPlace && noPath)
+			turn = 1;
+		else if (opts.turnInPlace && navigating && !plan.path.empty())
+		{
+			size_t i = 0;
+			double bestD = 1e18;
+			for (size_t k = 0; k < plan.path.size(); k++)
+			{
+				const double d = std::hypot(plan.path[k].x - known.x, plan.path[k].y - known.y);
+				if (d < bestD) bestD = d, i = k;
+			}
+			while (i + 1 < plan.path.size() &&
+				   std::hypot(plan.path[i].x - known.x, plan.path[i].y - known.y) < opts.lookAhead)
+				i++;
+			const double bearing =
+				mrpt::math::wrapToPi(std::atan2(plan.path[i].y - known.y, plan.path[i].x - known.x) - known.phi);
+			const double lim = mrpt::DEG2RAD(turning ? opts.turnStopDeg : opts.turnStartDeg);
+			const bool far = std::hypot(plan.path[i].x - known.x, plan.path[i].y - known.y) > ro.targetAllowedDistance;
+			if (far && std::abs(bearing) > lim) turn = bearing > 0 ? 1 : -1;
+		}
+		if (turn != 0)
+		{
+			// a turn in place sweeps the footprint's circumcircle: only if it is clear
+			const double R = ro.robotHalfSize * std::sqrt(2.0) + grid.getResolution();
+			for (double y = known.y - R; y <= known.y + R && turn != 0; y += grid.getResolution())
+				for (double x = known.x - R; x <= known.x + R; x += grid.getResolution())
+					if (std::hypot(x - known.x, y - known.y) <= R &&
+						grid.getPos(float(x), float(y)) < ro.obstacles.maxFreeProbability)
+					{
+						turn = 0;
+						break;
+					}
+		}
+		turning = turn != 0;
+		if (turning)
+		{
+			sim.movementCommand(0, turn * opts.turnRate);
+			r.turningSeconds += ro.dt;
+		}
+		else
+			nav->navigationStep();
 		sim.simulateOneTimeStep(ro.dt);
 		if (drift)
 		{
@@ -360,6 +445,11 @@ ClosedLoopResult runClosedLoopNavigation(
 		}
 		r.trajectory.push_back(sim.getCurrentGTPose());
 		r.seconds = t + ro.dt;
+		if (opts.onStep && !opts.onStep(r.seconds, r.trajectory.back()))
+		{
+			r.stoppedByCallback = true;
+			break;
+		}
 		if (navigating && nav->getWaypointNavStatus().final_goal_reached) break;
 		if (navigating && nav->getCurrentState() == mrpt::nav::CAbstractNavigator::NAV_ERROR) break;
 	}

@@ -21,6 +21,7 @@
 #include <mrpt/poses/CPose3D.h>
 
 #include <deque>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -34,6 +35,10 @@ namespace gam::nav
  * +X, the scene's sensor pose and intrinsics). `sensorNoise` false = exact. */
 mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
 	const gam::sim::SceneFile& sf, const gam::sim::Pose2& robot, std::mt19937& rng);
+/** The same in `scene` (e.g. sf.scene.atFrame(f): the people where they are
+ * then), with sf's camera. */
+mrpt::obs::CObservation3DRangeScan::Ptr simulateKinect(
+	const gam::sim::SceneFile& sf, const gam::sim::Scene& scene, const gam::sim::Pose2& robot, std::mt19937& rng);
 
 /** The two grids of one mapping run over the scene's path. */
 struct NavMaps
@@ -102,11 +107,23 @@ struct ReactiveOptions
 	std::string baseConfig = "/usr/share/mrpt/config_files/navigation-ptgs/reactive2d_config.ini";
 	std::string cacheDir = "/tmp";  ///< PTG look-up table cache files go here
 	double robotHalfSize = 0.25;    ///< square robot footprint, half side [m]
-	double refDistance = 4.0;       ///< PTG range [m]
-	double maxSpeed = 0.5;          ///< [m/s]
-	double maxTime = 40;            ///< simulated seconds
-	double dt = 0.05;               ///< simulation step [s]
+	/** The navigator's shape is the footprint grown by this [m] (its obstacles
+	 * are cell centres, so the footprint may reach half a cell into an
+	 * occupied cell). 0: one 5 cm cell, tried on gam-navbench, left 7 of the
+	 * first 25 ground-aware runs stuck in front of obstacles (2 in seeds 1-30
+	 * without it): the navigator finds fewer admissible motions. */
+	double footprintMargin = 0;
+	double refDistance = 4.0;  ///< PTG range [m]
+	double maxSpeed = 0.5;     ///< [m/s]
+	double maxTime = 40;       ///< simulated seconds
+	double dt = 0.05;          ///< simulation step [s]
 	float targetAllowedDistance = 0.3f;
+	/** Keep only the forward path families (PTGs) of the base config: MRPT's
+	 * example has a reversing one (CPTG_DiffDrive_C with K = -1), and the
+	 * walker's camera and Leddar look forward: reversing, it drives where it
+	 * has never looked (unknown cells are no obstacles), e.g. back into an
+	 * unseen hole, and a walker is pushed forward by its user anyway. */
+	bool forwardOnly = true;
 	ObstacleOptions obstacles;
 };
 
@@ -143,19 +160,44 @@ struct ClosedLoopOptions
 	 * arrival) is the true one. 0, 0 = exact odometry. */
 	double odometryScaleError = 0;
 	double odometryYawDriftDegPerM = 0;
+	/** Look before driving (issue #29, a forward-only walker whose camera sees
+	 * ~70 deg ahead): when the plan's point lookAhead metres ahead is more
+	 * than turnStartDeg off the heading, the robot turns in place towards it
+	 * (turnRate) until it is within turnStopDeg, instead of letting the
+	 * navigator drive an arc into cells it has not looked at; and when the
+	 * planner finds no path on the current grid, it turns in place to look
+	 * around (and replans every 0.5 s) instead of following the stale plan.
+	 * Only where the turn is safe on the current grid: no obstacle cell
+	 * (ObstacleOptions::maxFreeProbability) within the circle the square
+	 * footprint sweeps (robotHalfSize * sqrt(2)) plus one cell; otherwise the
+	 * navigator, which checks its motions against the obstacles, drives. */
+	bool turnInPlace = true;
+	double lookAhead = 0.6;    ///< [m]
+	double turnStartDeg = 60;  ///< [deg]
+	double turnStopDeg = 15;   ///< [deg]
+	double turnRate = 0.6;     ///< [rad/s]
+	/** Called after every simulation step with the simulated time and the
+	 * robot's TRUE pose; returning false ends the run there (a benchmark's
+	 * fall, collision or no progress). */
+	std::function<bool(double t, const mrpt::math::TPose2D& truePose)> onStep;
 };
 
 struct ClosedLoopResult : ReactiveResult
 {
-	size_t frames = 0;              ///< depth frames rendered and inserted
-	size_t leddarScans = 0;         ///< Leddar scans (one with each depth frame if the scene has a Leddar)
-	int plans = 0;                  ///< global plans computed (the first and the replans)
-	double finalOdometryError = 0;  ///< |odometry - true| at the end [m]
+	size_t frames = 0;               ///< depth frames rendered and inserted
+	size_t leddarScans = 0;          ///< Leddar scans (one with each depth frame if the scene has a Leddar)
+	int plans = 0;                   ///< global plans computed (the first and the replans)
+	int failedPlans = 0;             ///< planner calls that found no path
+	double turningSeconds = 0;       ///< time spent turning in place (turnInPlace)
+	double finalOdometryError = 0;   ///< |odometry - true| at the end [m]
+	bool stoppedByCallback = false;  ///< opts.onStep returned false
 };
 
 /** Issue #29, closed loop: the walker maps while it drives. Every
  * frameInterval the scene's Kinect renders a depth frame at the robot's true
- * pose, with the scene's Leddar scan if it has one, and `grid` (a fresh or
+ * pose (frame k at time k * frameInterval, in the scene as it is in its frame
+ * k: Scene::atFrame, so that people cross as the scene file makes them),
+ * with the scene's Leddar scan if it has one, and `grid` (a fresh or
  * stock-started grid; it is updated) inserts them
  * at the odometry pose (exact unless opts sets a drift). PlannerSimple2D plans on the current
  * grid from the robot to `goal`; CReactiveNavigationSystem follows that plan
