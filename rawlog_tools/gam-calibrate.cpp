@@ -71,8 +71,7 @@ struct Camera
 {
 	std::vector<gam::SensorMount> perFrame;
 	size_t frames = 0;
-	size_t searched = 0;                           ///< frames whose floor the search found near the declared mount
-	std::vector<gam::SensorMount> searchedMounts;  ///< what the search found (before the map's plane)
+	std::vector<gam::SensorMount> searchedMounts;  ///< what the search found near the declared mount, per frame
 	size_t mapPlaneOverruled = 0;                  ///< frames where the map's plane left the search's
 	mrpt::poses::CPose3D declared;
 };
@@ -226,7 +225,6 @@ int main(int argc, char** argv)
 				if (const auto m = floor ? gam::mountFromFloor(*floor) : std::nullopt)
 				{
 					fr.obs->setSensorPose(mrpt::poses::CPose3D(dp.x(), dp.y(), m->height, dp.yaw(), m->pitch, m->roll));
-					cam.searched++;
 					cam.searchedMounts.push_back(*m);
 					searched = m;
 				}
@@ -280,7 +278,7 @@ int main(int argc, char** argv)
 				"  declared sensorPose: z=%.4f pitch=%.3f roll=%.3f (x=%.4f y=%.4f yaw=%.3f kept: not observable from "
 				"the floor); floor found by the search in %zu frames; %zu frames had a floor plane, %zu rejected\n",
 				cam.declared.z(), cam.declared.pitch() * k, cam.declared.roll() * k, cam.declared.x(), cam.declared.y(),
-				cam.declared.yaw() * k, cam.searched, cam.perFrame.size(), cam.perFrame.size() - e.used);
+				cam.declared.yaw() * k, cam.searchedMounts.size(), cam.perFrame.size(), cam.perFrame.size() - e.used);
 			if (!cam.searchedMounts.empty())
 			{
 				const gam::MountEstimate se = gam::estimateMount(cam.searchedMounts);

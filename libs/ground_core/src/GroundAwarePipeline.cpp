@@ -158,15 +158,12 @@ const FrameResult& GroundAwarePipeline::process(
 	// 3. Evidence, within the range of trust of the camera.
 	m_result.sensor = frame.sensor_position;
 	double evidenceRange = m_params.projection.max_range;
-	if (!paperIsm)
+	if (!paperIsm && cam.range_of_trust && frame.has_image)
 	{
-		if (cam.range_of_trust && frame.has_image)
-		{
-			m_result.trust_range = trustRange(
-				noise, frame.intrinsics.fx, frame.sensor_position.z() - robot.z(), lattice.resolution,
-				m_params.ism.noise_sigmas, m_params.ism.traversable_step, evidenceRange);
-			evidenceRange = std::min(evidenceRange, m_result.trust_range);
-		}
+		m_result.trust_range = trustRange(
+			noise, frame.intrinsics.fx, frame.sensor_position.z() - robot.z(), lattice.resolution,
+			m_params.ism.noise_sigmas, m_params.ism.traversable_step, evidenceRange);
+		evidenceRange = std::min(evidenceRange, m_result.trust_range);
 	}
 	m_ism.compute(m_grid, m_result.detection, m_result.sensor, evidenceRange, m_result.ism, &m_bins);
 	const auto t4 = clk::now();

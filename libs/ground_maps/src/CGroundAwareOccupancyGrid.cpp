@@ -413,7 +413,6 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 		cam.height = frame.sensor_position.z() - robotPose.z();
 		cam.width = frame.intrinsics.width;
 		cam.height_px = frame.intrinsics.height;
-		cam.frames++;
 	}
 	if (m_options.mount.enabled)
 	{

@@ -10,6 +10,18 @@ namespace
 {
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kFar = 20.0;  // ray-cast horizon for the true depth [m]
+
+/** Whether the surface `objectId` returns nothing to this pixel: absorbing
+ * surfaces never do, shiny ones drop out at random (only with noise). The
+ * floor (0) always returns. One uniform draw for a specular surface. */
+bool materialDropout(
+	const Scene& scene, int objectId, bool noise, std::uniform_real_distribution<double>& uni, std::mt19937& rng)
+{
+	if (objectId == 0) return false;
+	const ObjectInfo* oi = scene.object(objectId);
+	const Material m = oi ? oi->material : Material::Normal;
+	return m == Material::Absorbing || (m == Material::Specular && noise && uni(rng) < oi->dropout);
+}
 }  // namespace
 
 double KinectParams::fx() const { return 0.5 * width / std::tan(0.5 * hfov_deg * kDeg); }
@@ -240,16 +252,10 @@ DepthFrame KinectModel::render(const Scene& scene, const Pose3& sensor, std::mt1
 		const double z = f.true_depth[i];
 		double d = z;
 		if (!multipath.empty()) d += multipath[i];
-		if (f.object_id[i] != 0 && std::isfinite(z))
+		if (std::isfinite(z) && materialDropout(scene, f.object_id[i], p.noise, uni, rng))
 		{
-			// Absorbing surfaces return nothing; shiny ones drop out at random.
-			const ObjectInfo* oi = scene.object(f.object_id[i]);
-			const Material m = oi ? oi->material : Material::Normal;
-			if (m == Material::Absorbing || (m == Material::Specular && p.noise && uni(rng) < oi->dropout))
-			{
-				f.flags[i] |= PixDropout;
-				continue;
-			}
+			f.flags[i] |= PixDropout;
+			continue;
 		}
 		if (p.noise)
 		{
@@ -416,15 +422,10 @@ void KinectModel::renderDisparityNoise(const Scene& scene, DepthFrame& f, std::m
 		{
 			const size_t i = f.idx(r, c);
 			if (disp[i] <= 0 || (f.flags[i] & PixOccluded)) continue;
-			if (f.object_id[i] != 0)
+			if (materialDropout(scene, f.object_id[i], p.noise, uni, rng))
 			{
-				const ObjectInfo* oi = scene.object(f.object_id[i]);
-				const Material m = oi ? oi->material : Material::Normal;
-				if (m == Material::Absorbing || (m == Material::Specular && p.noise && uni(rng) < oi->dropout))
-				{
-					f.flags[i] |= PixDropout;
-					continue;
-				}
+				f.flags[i] |= PixDropout;
+				continue;
 			}
 			double d = disp[i];
 			if (p.noise)

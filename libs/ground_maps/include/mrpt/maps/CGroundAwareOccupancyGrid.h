@@ -152,7 +152,6 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		double trust_range = 0;  ///< [m]; +inf when not limited
 		double height = 0;       ///< sensor above the robot's floor [m]
 		int width = 0, height_px = 0;
-		size_t frames = 0;
 	};
 	const std::map<std::string, TCameraInfo>& cameras() const { return m_cameras; }
 	/** The label of the last depth frame's sensor (its entry in mountChecks()). */
