@@ -41,7 +41,7 @@ struct Result
 /** Runs the projector, the 2.5D map, hand-made classes (every cell with
  * samples is Ground) and the detector on `scene`. The grid is 20 x 20 cells
  * from (-0.5, -0.5): the image sees only its middle 10 x 10 cells. */
-void run(const Scene& scene, Result& out, MissingFloorParams p = {})
+void run(const Scene& scene, Result& out, MissingFloorParams p = {}, double baseline = 0)
 {
 	PinholeIntrinsics K;
 	K.width = K.height = kSize;
@@ -83,6 +83,7 @@ void run(const Scene& scene, Result& out, MissingFloorParams p = {})
 	Plane floor;           // z = 0
 	p.stats_row_step = 1;  // every row, for the hand counts below
 	out.det.setParams(p);
+	out.det.setSecondImagerBaseline(baseline);
 	out.det.compute(frame, proj, 1, 4.5, floor, out.grid, classes, out.stats);
 }
 
@@ -287,4 +288,63 @@ TEST(MissingFloor, ParametersAreValidated)
 	p = {};
 	p.range_bin = 0;
 	EXPECT_THROW(MissingFloorDetector{p}, std::invalid_argument);
+}
+
+TEST(MissingFloor, OutsideTheSecondImager)
+{
+	// A D435-like camera: fx = 640 px, baseline 0.05 m, fx b = 32 px m. Floor
+	// at 2 m has a disparity of 32 / 2 = 16 px: column c lands at c - 16 in
+	// the second image, outside it for c - 16 <= -0.5 (lround < 0): c <= 15.
+	EXPECT_TRUE(missing::outsideSecondImager(0, 2.0, 32.0));
+	EXPECT_TRUE(missing::outsideSecondImager(15, 2.0, 32.0));
+	EXPECT_FALSE(missing::outsideSecondImager(16, 2.0, 32.0));
+	// Nearer floor, a wider band: at 1 m, 32 px (c <= 31); at 4 m, 8 px.
+	EXPECT_TRUE(missing::outsideSecondImager(31, 1.0, 32.0));
+	EXPECT_FALSE(missing::outsideSecondImager(32, 1.0, 32.0));
+	EXPECT_TRUE(missing::outsideSecondImager(7, 4.0, 32.0));
+	EXPECT_FALSE(missing::outsideSecondImager(8, 4.0, 32.0));
+	// The tie: d = 28 / 8 = 3.5 px, c - d = 3 - 3.5 = -0.5 rounds to -1
+	// (std::lround: half away from zero): outside; c = 4 gives 0.5 -> 1.
+	EXPECT_TRUE(missing::outsideSecondImager(3, 8.0, 28.0));
+	EXPECT_FALSE(missing::outsideSecondImager(4, 8.0, 28.0));
+	EXPECT_FALSE(missing::outsideSecondImager(16, 0.0, 32.0));  // no depth: no claim
+	EXPECT_FALSE(missing::outsideSecondImager(0, 2.0, 0.0));    // time of flight: no band
+}
+
+TEST(MissingFloor, TheStereoInvalidBandIsNoEvidence)
+{
+	// fx = 80, baseline 0.05 m: fx b = 4 px m; the floor (1 m) has a
+	// disparity of 4 px, so columns 0-3 (c - 4 <= -1) are outside the second
+	// imager: a stereo camera returns nothing there. Their 40 x 4 = 160
+	// pixels fill the 10 cells of y cell 14 ((19.5 - c) / 80 = 0.244 ..
+	// 0.206), 16 rays each.
+	Scene s;
+	for (int r = 0; r < kSize; r++)
+		for (int c = 0; c < 4; c++) s.at(r, c) = 0;
+
+	// Read as a time-of-flight camera: 160 empty rays, 10 candidate cells
+	// (none missing: at the edge of the view, no floor beyond them).
+	Result tof;
+	run(s, tof);
+	EXPECT_EQ(tof.stats.rays, 1600u);
+	EXPECT_EQ(tof.stats.empty_rays, 160u);
+	EXPECT_EQ(tof.stats.candidates, 10u);
+
+	// With the baseline those pixels are no rays at all: 1600 - 160 = 1440.
+	Result stereo;
+	run(s, stereo, {}, 0.05);
+	EXPECT_EQ(stereo.stats.rays, 1440u);
+	EXPECT_EQ(stereo.stats.empty_rays, 0u);
+	EXPECT_EQ(stereo.stats.candidates, 0u);
+
+	// A dark hole the second imager does see (rows 16-23, columns 24-31: the
+	// hole of DarkHoleInSeenFloorIsMarked) is still a hole: its 4 cells.
+	for (int r = 16; r < 24; r++)
+		for (int c = 24; c < 32; c++) s.at(r, c) = 0;
+	Result hole;
+	run(s, hole, {}, 0.05);
+	EXPECT_EQ(hole.stats.empty_rays, 64u);
+	EXPECT_EQ(hole.stats.cells, 4u);
+	EXPECT_TRUE(hole.det.isMissing(cellOf(9, 7)));
+	EXPECT_TRUE(hole.det.isMissing(cellOf(10, 8)));
 }

@@ -3,8 +3,12 @@
 # - single mode, two holes (10 x 5 cm and 30 x 5 cm), ranges 1.0 and 4.0 m,
 #   one seed: the table has its header and one row per object, with the
 #   geometric limits by hand: 0.10 * 0.8 / 0.03 = 2.67 m and
-#   0.30 * 0.8 / 0.03 = 8.0 m capped by the 4.5 m range; the summary CSV has
-#   one row per object and map and names the commit;
+#   0.30 * 0.8 / 0.03 = 8.0 m capped by the 4.5 m range; the Kinect One's
+#   range of trust is the map's whole 5 m, so the limits stay 2.67 and 4.5 m;
+#   the summary CSV has one row per object and map and names the commit;
+# - --camera d435 --maps ground_aware: one map; the geometric limit of the
+#   30 cm hole is 8.0 m capped by the map's 5 m (the D435 reaches 6 m), and
+#   the limit is the range of trust the mapper prints (below 5 m at 0.8 m);
 # - approach mode, the 30 x 5 cm hole, one seed: a row whose ground_aware
 #   entry is a range within the 5.0 .. 1.0 m the approach covers;
 # - --help exits 0; a bad option, a missing build and --objects matching
@@ -21,23 +25,36 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 	--out "$w/single" --csv "$w/single.csv" --commit smoke >"$w/single.txt" 2>"$w/single.err" ||
 	{ cat "$w/single.err"; fail "single run failed"; }
 cat "$w/single.txt"
-grep -qxF "| object | geometric limit [m] | ground_aware [m] | ratio to the limit | height_band [m] | octomap [m] |" \
-	"$w/single.txt" || fail "single-frame table header"
-grep -Eq '^\| hole_0\.10x0\.05 \| 2\.67 \| (1\.00|4\.00|not detected)( \(gaps\))? \| [-0-9.]+ \| ' "$w/single.txt" ||
-	fail "hole_0.10x0.05 row (limit 2.67)"
-grep -Eq '^\| hole_0\.30x0\.05 \| 4\.50 \| (1\.00|4\.00|not detected)( \(gaps\))? \| [-0-9.]+ \| ' "$w/single.txt" ||
-	fail "hole_0.30x0.05 row (limit 8.0 m capped at 4.50)"
+hdr="| object | geometric limit [m] | range of trust [m] | limit [m] | ground_aware [m] | ratio to the limit |"
+grep -qxF "$hdr height_band [m] | octomap [m] |" "$w/single.txt" || fail "single-frame table header"
+grep -Eq '^\| hole_0\.10x0\.05 \| 2\.67 \| 5\.00 \| 2\.67 \| (1\.00|4\.00|not detected)( \(gaps\))? \| [-0-9.]+ \| ' \
+	"$w/single.txt" || fail "hole_0.10x0.05 row (limit 2.67)"
+grep -Eq '^\| hole_0\.30x0\.05 \| 4\.50 \| 5\.00 \| 4\.50 \| (1\.00|4\.00|not detected)( \(gaps\))? \| [-0-9.]+ \| ' \
+	"$w/single.txt" || fail "hole_0.30x0.05 row (limit 8.0 m capped at 4.50)"
 [[ "$(grep -c '^| hole_' "$w/single.txt")" -eq 2 ]] || fail "two rows expected"
 grep -qx "# commit: smoke" "$w/single.csv" || fail "CSV names the commit"
 [[ "$(grep -c '^hole_0\.[13]0x0\.05,hole,.*,single,' "$w/single.csv")" -eq 6 ]] || fail "CSV: 2 objects x 3 maps"
-grep -q '^hole_0.30x0.05,hole,0.3,0.05,4.5,single,ground_aware,1,' "$w/single.csv" || fail "CSV limit column"
+grep -q '^hole_0.30x0.05,hole,0.3,0.05,kinect_one,4.5,5.0,4.5,single,ground_aware,1,' "$w/single.csv" ||
+	fail "CSV limit columns"
 [[ -s "$w/single/detections.csv" && -s "$w/single/tables.md" ]] || fail "--out files"
+
+"$tool" --build "$build" --camera d435 --maps ground_aware --modes single --objects '^hole_0\.30x0\.05$' \
+	--ranges "1.5" --seeds 1 --csv "$w/d435.csv" --commit smoke >"$w/d435.txt" 2>"$w/d435.err" ||
+	{ cat "$w/d435.err"; fail "d435 run failed"; }
+cat "$w/d435.txt"
+grep -qxF "$hdr" "$w/d435.txt" || fail "d435 table header: ground_aware only"
+row="$(grep '^| hole_0.30x0.05 | 5.00 |' "$w/d435.txt")" || fail "d435 row (8.0 m capped at the map's 5 m)"
+trust="$(cut -d'|' -f4 <<<"$row" | xargs)" limit="$(cut -d'|' -f5 <<<"$row" | xargs)"
+awk -v t="$trust" -v l="$limit" 'BEGIN { exit !(t + 0 > 1.5 && t + 0 < 5.0 && l == t) }' ||
+	fail "d435: range of trust '$trust' not in (1.5, 5) m or not the limit ('$limit')"
+grep -qx "# camera: d435" "$w/d435.csv" || fail "d435 CSV names the camera"
+[[ "$(grep -c '^hole_0.30x0.05,hole,' "$w/d435.csv")" -eq 1 ]] || fail "d435 CSV: one map"
 
 "$tool" --build "$build" --modes approach --objects '^hole_0\.30x0\.05$' --seeds 1 --out "$w/appr" \
 	>"$w/appr.txt" 2>"$w/appr.err" || { cat "$w/appr.err"; fail "approach run failed"; }
 cat "$w/appr.txt"
 row="$(grep '^| hole_0.30x0.05 | 4.50 |' "$w/appr.txt")" || fail "approach row"
-ga="$(cut -d'|' -f4 <<<"$row" | xargs)"
+ga="$(cut -d'|' -f6 <<<"$row" | xargs)"
 awk -v v="$ga" 'BEGIN { exit !(v + 0 >= 1.0 && v + 0 <= 5.0) }' || fail "approach ground_aware '$ga' not in 1..5 m"
 [[ "$(awk -F, '$2 == "approach" && $6 == "ground_aware"' "$w/appr/detections.csv" | wc -l)" -eq 81 ]] ||
 	fail "approach: 81 frames per map"

@@ -174,6 +174,7 @@ const FrameResult& GroundAwarePipeline::process(
 		m_result.detection.ok() && m_result.ism.applied)
 	{
 		const double range = std::min<double>(frame.max_range, evidenceRange);
+		m_missing.setSecondImagerBaseline(noise.baseline);
 		m_missing.compute(
 			frame, m_projector, m_params.projection.decimation, range, m_result.detection.plane(), m_grid,
 			m_ism.classes(), m_result.missing);

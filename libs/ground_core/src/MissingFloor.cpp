@@ -16,6 +16,12 @@ double emptyCellChance(double q, double p11, int n)
 	const double next = std::max(q, std::min(p11, 1.0));
 	return q * std::pow(next, n - 1);
 }
+
+bool outsideSecondImager(int c, double z, double fxBaseline)
+{
+	// lround(c - d) < 0, i.e. c - d <= -0.5, without a libm call per pixel.
+	return z > 0 && double(c) - fxBaseline / z + 0.5 <= 0.0;
+}
 }  // namespace missing
 
 void MissingFloorDetector::clear()
@@ -87,6 +93,9 @@ void MissingFloorDetector::compute(
 	const Eigen::Vector3d nr = R.transpose() * n;
 	const float units = img.units;
 	const int step = std::max(1, decimation);
+	// Depth from disparity: pixels in the second imager's invalid band return
+	// nothing whatever lies there (range images: not applied).
+	const double fxBaseline = img.is_depth ? K.fx * m_baseline : 0.0;
 
 	// 1. Every pixel whose ray meets the ground inside the range: one ray of
 	// the cell it meets; empty if the camera returned nothing there. Along
@@ -147,6 +156,7 @@ void MissingFloorDetector::compute(
 			}
 			if (expected < m_params.min_range || expected > maxRange) continue;
 			if (!(CX[c] >= 0.f && CY[c] >= 0.f)) continue;
+			if (v == 0 && fxBaseline > 0 && missing::outsideSecondImager(c, t, fxBaseline)) continue;
 			const int cx = int(CX[c]), cy = int(CY[c]);
 			if (cx >= g.nx || cy >= g.ny) continue;
 			const double got = double(v) * units;

@@ -110,6 +110,15 @@ namespace missing
  * (a Markov chain along the rays): q * max(q, p11)^(n-1); q^n for
  * independent dropouts (p11 = q). */
 double emptyCellChance(double q, double p11, int n);
+
+/** Depth from disparity (active stereo, structured light): a pixel returns
+ * depth only if the second imager (or the projector), `baseline` to the
+ * image's right, sees its point too. A point at column c and depth z appears
+ * there at column c - fx baseline / z; left of column 0 (rounded as
+ * std::lround) it is outside that view: the invalid band at the image's left
+ * edge, fx baseline / z pixels wide. Such a pixel returns nothing whatever
+ * lies there. */
+bool outsideSecondImager(int c, double z, double fxBaseline);
 }  // namespace missing
 
 class MissingFloorDetector
@@ -123,6 +132,11 @@ class MissingFloorDetector
 		m_params = p;
 	}
 	const MissingFloorParams& params() const { return m_params; }
+	/** The camera's stereo (or projector) baseline [m], second imager to the
+	 * image's right; 0 (time of flight) = every pixel could have returned.
+	 * With a baseline, empty pixels of depth images in the second imager's
+	 * invalid band are no evidence (missing::outsideSecondImager). */
+	void setSecondImagerBaseline(double baseline) { m_baseline = baseline > 0 ? baseline : 0; }
 
 	/** One depth frame (frame.has_image) after the 2.5D map, the ground and
 	 * the ISM classes of that frame are known. `projector` holds the ray
@@ -162,6 +176,7 @@ class MissingFloorDetector
 	std::vector<uint32_t> m_touched, m_cells, m_blocking, m_queue, m_region;
 	std::vector<uint32_t> m_binRays, m_binEmpty;
 	double m_p11 = -1;
+	double m_baseline = 0;
 	// One image row: depth at which each ray meets the ground and the
 	// (fractional) grid cell it meets there; computed in a vectorizable loop.
 	std::vector<float> m_rowT, m_rowCx, m_rowCy;
