@@ -148,6 +148,59 @@ TEST(Ramps, NarrowSteepRampGetsItsOwnPatch)
 	EXPECT_LT(bareOnRamp, onIt);
 }
 
+TEST(Ramps, NoisyFloorBeyondTheEvidenceRangeIsLeftOut)
+{
+	// The ramp scene seen by a noisy wide camera: the floor and ramp within
+	// 2.9 m (2D) of the sensor with 2 mm of noise per sample, the floor
+	// beyond with 25 mm (a D435's far floor). The map takes evidence within
+	// 2.9 m only (its range of trust), so fill_patches adds no node beyond
+	// it, and the patches' inlier distance is the noise within it.
+	ElevationGrid grid;
+	std::mt19937 rng(13);
+	BinnedPoints b;
+	const auto near = [](double x, double y) { return inRect(x, y, -1.0, 4.5, -2.5, 2.5) && std::hypot(x, y) < 2.9; };
+	const auto far = [](double x, double y) { return inRect(x, y, -1.0, 4.5, -2.5, 2.5) && std::hypot(x, y) >= 2.9; };
+	gamtest::sampleSurfaceIf(grid, near, rampZ, 3, 0.002, rng, b);
+	gamtest::sampleSurfaceIf(grid, far, rampZ, 3, 0.025, rng, b);
+	gamtest::insertAll(grid, b);
+	grid.interpolateIdw(IdwParams{});
+
+	RrtGroundDetector det;
+	GroundSeedHint all{0, 0, 0};  // fill and noise band over the whole grid
+	GroundDetection wide;
+	det.detect(grid, all, wide);
+	ASSERT_TRUE(wide.ok()) << wide.describe();
+
+	GroundSeedHint hint = all;
+	hint.fill_range = 2.9;
+	GroundDetection inRange;
+	det.detect(grid, hint, inRange);
+	ASSERT_TRUE(inRange.ok()) << inRange.describe();
+	std::cout << "patch inlier distance: whole grid " << wide.patch_inlier_distance << " m, within 2.9 m "
+			  << inRange.patch_inlier_distance << " m; filled nodes " << wide.fill_nodes << " / " << inRange.fill_nodes
+			  << std::endl;
+
+	// Every filled node lies within 2.9 m of the sensor (at (0, 0)).
+	ASSERT_GT(inRange.fill_nodes, 0u);
+	for (size_t i = inRange.nodes.size() - inRange.fill_nodes; i < inRange.nodes.size(); i++)
+		EXPECT_LE(std::hypot(inRange.nodes[i].x, inRange.nodes[i].y), 2.9 + 1e-6);
+	size_t farFilled = 0;
+	for (size_t i = wide.nodes.size() - wide.fill_nodes; i < wide.nodes.size(); i++)
+		farFilled += std::hypot(wide.nodes[i].x, wide.nodes[i].y) > 2.9;
+	EXPECT_GT(farFilled, 0u);  // without the bound the noisy far floor draws filled nodes
+	// The band within 2.9 m is that of 2 mm noise (3 sigma of the nodes plus
+	// d_r / 2 * tan(asin 0.2) = 5.1 mm, as NarrowSteepRampGetsItsOwnPatch);
+	// the far floor's noise widens the whole grid's.
+	EXPECT_LT(inRange.patch_inlier_distance, 0.015);
+	EXPECT_GT(wide.patch_inlier_distance, inRange.patch_inlier_distance);
+	// And the way up is fitted at its own 8 deg.
+	bool ramp8 = false;
+	for (size_t k = 1; k < inRange.planes.size(); k++)
+		ramp8 |= std::abs(rad2deg(inRange.planes[k].tiltAngle()) - 8.0) < 1.0 &&
+				 std::abs(inRange.planes[k].heightAt(2.0, 0.0) - kTan8) < 0.01;
+	EXPECT_TRUE(ramp8) << inRange.describe();
+}
+
 TEST(Ramps, TheWayDownIsFittedAtItsOwnSlope)
 {
 	// The way down (x in [2.8, 4.0)) is a patch at 8 deg: 0.1686 - 0.1405 *

@@ -138,11 +138,24 @@ const FrameResult& GroundAwarePipeline::process(
 	}
 	const auto t2 = clk::now();
 
+	// The range of trust of the camera: the map takes no evidence beyond it.
+	double evidenceRange = m_params.projection.max_range;
+	if (!paperIsm && cam.range_of_trust && frame.has_image)
+	{
+		m_result.trust_range = trustRange(
+			noise, frame.intrinsics.fx, frame.sensor_position.z() - robot.z(), lattice.resolution,
+			m_params.ism.noise_sigmas, m_params.ism.traversable_step, evidenceRange);
+		evidenceRange = std::min(evidenceRange, m_result.trust_range);
+	}
+
 	// 2. Ground: RRT-GPD seeded under the robot.
 	GroundSeedHint hint;
 	hint.x = robot.x();
 	hint.y = robot.y();
 	hint.floor_z = robot.z();
+	hint.sensor_x = frame.sensor_position.x();
+	hint.sensor_y = frame.sensor_position.y();
+	if (std::isfinite(m_result.trust_range)) hint.fill_range = evidenceRange;
 	m_rrt.detect(m_grid, hint, m_result.detection);
 	GroundDetection& det = m_result.detection;
 	if (m_params.max_ground_offset > 0 && m_params.rrt.variant != MethodVariant::Paper && det.ok() &&
@@ -157,14 +170,6 @@ const FrameResult& GroundAwarePipeline::process(
 
 	// 3. Evidence, within the range of trust of the camera.
 	m_result.sensor = frame.sensor_position;
-	double evidenceRange = m_params.projection.max_range;
-	if (!paperIsm && cam.range_of_trust && frame.has_image)
-	{
-		m_result.trust_range = trustRange(
-			noise, frame.intrinsics.fx, frame.sensor_position.z() - robot.z(), lattice.resolution,
-			m_params.ism.noise_sigmas, m_params.ism.traversable_step, evidenceRange);
-		evidenceRange = std::min(evidenceRange, m_result.trust_range);
-	}
 	m_ism.compute(m_grid, m_result.detection, m_result.sensor, evidenceRange, m_result.ism, &m_bins);
 	const auto t4 = clk::now();
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -70,8 +71,8 @@ struct RrtGpdParams
 	 * tree puts a node every ~d_n and reaches a narrow ramp only through its
 	 * foot: a 0.7 m wide 8 deg ramp got a handful of nodes near its foot in
 	 * 4 of 11 frames, too few (and too collinear) for a patch of its own;
-	 * filled, its nodes tile it with their own fit windows. Not in the paper
-	 * variant. */
+	 * filled, its nodes tile it with their own fit windows. Only within
+	 * GroundSeedHint::fill_range of the sensor. Not in the paper variant. */
 	bool fill_patches = true;
 	uint32_t random_seed = 1;
 
@@ -197,6 +198,14 @@ struct GroundSeedHint
 {
 	double x = 0, y = 0;  ///< robot position in the grid frame
 	double floor_z = 0;   ///< expected floor height in the grid frame
+	/** fill_patches adds no node farther than this (2D) from (sensor_x,
+	 * sensor_y): the range within which the map takes evidence (the camera's
+	 * range of trust). Patches beyond it would judge cells that get none. */
+	double fill_range = std::numeric_limits<double>::infinity();
+	/** fill_range also bounds the nodes whose spread about the ground plane
+	 * gives the extra patches' inlier distance: the noise where the patches
+	 * judge cells, not that of far floor no cell is judged against. */
+	double sensor_x = 0, sensor_y = 0;
 };
 
 /** Algorithm 1's search window (rrt_variant = paper): centred on the centroid
@@ -313,9 +322,10 @@ class RrtGroundDetector
 	std::vector<int> m_cluster;
 	std::vector<size_t> m_bfs;
 	/** fill_patches: adds nodes over the ground off `ground` (see RrtGpdParams). */
-	void fillPatches(const ElevationGrid& grid, const Plane& ground, GroundDetection& out);
+	void fillPatches(const ElevationGrid& grid, const Plane& ground, const GroundSeedHint& hint, GroundDetection& out);
 	std::vector<uint32_t> m_fillQueue;
 	double m_resolution = 0.05;  ///< of the grid in detect() [m]
+	GroundSeedHint m_hint;       ///< of the frame in detect()
 	std::vector<double> m_absDist;
 	void reserveScratch(const GridGeometry& g);
 	size_t maxTreeNodes(const GridGeometry& g) const;
