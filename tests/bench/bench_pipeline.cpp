@@ -9,8 +9,10 @@
 // frames, and the ratios; then the ground-aware grid's stages (median / p95);
 // with --full-octomap=M, also the octomap fed every pixel (first M frames).
 #include <benchmark/benchmark.h>
+#include <gam/core/CameraNoise.h>
 #include <gam/maps/ObservationAdapters.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
+
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
 #include <mrpt/maps/COctoMapGrid2D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
@@ -18,11 +20,13 @@
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CRawlog.h>
 #include <mrpt/system/filesystem.h>
+#include "gam/core/CameraNoise.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <functional>
 #include <iostream>
 #include <memory>
@@ -166,18 +170,36 @@ double quantile(std::vector<double> v, double q)
 // The ground-aware grid's own per-stage timings (lastFrame()), frame by frame.
 struct StageSeries
 {
-	std::vector<double> projection, outliers, ground, ism, update, total;
+	std::vector<double> projection, outliers, ground, ism, missing, update, total;
+	gam::CameraModel camera = gam::CameraModel::Custom;
 	void add(const CGroundAwareOccupancyGrid& grid)
 	{
 		const gam::StageTimes& l = grid.lastFrame().ms;
+		camera = grid.lastFrame().camera;
 		projection.push_back(l.projection);
 		outliers.push_back(l.outliers);
 		ground.push_back(l.ground);
 		ism.push_back(l.ism);
+		missing.push_back(l.missing);
 		update.push_back(grid.lastFrameTimes().update);
 		total.push_back(grid.lastFrameTimes().total);
 	}
 };
+
+// The CPU the figures were taken on (they mean little without it).
+std::string cpuName()
+{
+	std::ifstream in("/proc/cpuinfo");
+	std::string line, name;
+	int cpus = 0;
+	while (std::getline(in, line))
+		if (line.rfind("model name", 0) == 0)
+		{
+			cpus++;
+			if (name.empty()) name = line.substr(line.find(':') + 2);
+		}
+	return name.empty() ? std::string("unknown CPU") : name + ", " + std::to_string(cpus) + " CPUs";
+}
 
 // Single-frame rawlogs are inserted repeatedly: about 40 insertions per map.
 int roundsFor(const Dataset& d) { return std::max(1, int(40 / d.frames.size())); }
@@ -239,6 +261,7 @@ int main(int argc, char** argv)
 	// stages, and so does the same grid in paper mode (ism_model = rrt_variant = paper).
 	std::vector<StageSeries> stages(g_data.size()), paperStages(g_data.size());
 	std::vector<double> groundAwareMedian(g_data.size());
+	std::printf("\nCPU: %s (one core per map; compare within a row)\n", cpuName().c_str());
 	std::printf(
 		"\n| data | frames | px/frame | ground_aware median / p95 ms | height_band median / p95 ms | octomap median / "
 		"p95 ms | height_band / ground_aware | octomap / ground_aware |\n|---|---|---|---|---|---|---|---|\n");
@@ -268,9 +291,9 @@ int main(int argc, char** argv)
 	}
 
 	std::printf(
-		"\nground_aware per stage (the map's own timers), default and paper mode, median / p95 ms:\n\n| data | 2.5D "
-		"projection | 3-sigma "
-		"filter + IDW | RRT-GPD | ISM | grid update | whole frame |\n|---|---|---|---|---|---|---|\n");
+		"\nground_aware per stage (the map's own timers), default and paper mode, median / p95 ms (camera: the "
+		"model the map took the frames for):\n\n| data | camera | 2.5D projection | 3-sigma filter + IDW | RRT-GPD | "
+		"ISM | missing floor | grid update | whole frame |\n|---|---|---|---|---|---|---|---|---|\n");
 	auto mp = [](const std::vector<double>& v) {
 		char b[64];
 		std::snprintf(b, sizeof b, "%.3f / %.3f", quantile(v, 0.5), quantile(v, 0.95));
@@ -280,10 +303,12 @@ int main(int argc, char** argv)
 		for (size_t k = 0; k < g_data.size(); k++)
 		{
 			const StageSeries& t = (*series)[k];
+			const char* camera = series == &paperStages ? "-" : gam::kCameraModelNames[int(t.camera)];
 			std::printf(
-				"| %s%s | %s | %s | %s | %s | %s | %s |\n", g_data[k].name.c_str(),
-				series == &paperStages ? " (paper mode)" : "", mp(t.projection).c_str(), mp(t.outliers).c_str(),
-				mp(t.ground).c_str(), mp(t.ism).c_str(), mp(t.update).c_str(), mp(t.total).c_str());
+				"| %s%s | %s | %s | %s | %s | %s | %s | %s | %s |\n", g_data[k].name.c_str(),
+				series == &paperStages ? " (paper mode)" : "", camera, mp(t.projection).c_str(), mp(t.outliers).c_str(),
+				mp(t.ground).c_str(), mp(t.ism).c_str(), mp(t.missing).c_str(), mp(t.update).c_str(),
+				mp(t.total).c_str());
 		}
 
 	if (fullOctomapFrames > 0)
