@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace gam
 {
@@ -93,62 +94,58 @@ void MissingFloorDetector::compute(
 	// each row, pairs of neighbours that both meet seen floor give p11.
 	size_t pairsAfterEmpty = 0, pairsBothEmpty = 0;
 	const int cols = img.cols;
-	if (int(m_rowT.size()) < cols)
-	{
-		m_rowT.resize(size_t(cols));
-		m_rowCx.resize(size_t(cols));
-		m_rowCy.resize(size_t(cols));
-	}
 	// Per ray (1, fy, fz): down = nr.(1, fy, fz), t = -h / down, and the map
-	// point s + t R (1, fy, fz), as fractional cell indices. Float is plenty
-	// for a cell index and lets the row loop vectorize.
+	// point s + t R (1, fy, fz), as fractional cell indices, all in float.
 	const float n0 = float(nr.x()), n1 = float(nr.y()), n2 = float(nr.z()), mh = float(-h);
 	const float invRes = float(1.0 / g.resolution);
 	const float bx = float((s.x() - g.x_min) / g.resolution), by = float((s.y() - g.y_min) / g.resolution);
 	const float X0 = float(R(0, 0)) * invRes, X1 = float(R(0, 1)) * invRes, X2 = float(R(0, 2)) * invRes;
 	const float Y0 = float(R(1, 0)) * invRes, Y1 = float(R(1, 1)) * invRes, Y2 = float(R(1, 2)) * invRes;
+	// A return within the range is never an empty ray: raw values 1..rawInRange
+	// are exactly those with double(v) * units <= maxRange (monotone in v).
+	uint16_t rawInRange = uint16_t(std::min(65535.0, std::floor(maxRange / double(units))));
+	while (rawInRange < 65535 && double(rawInRange + 1) * units <= maxRange) rawInRange++;
+	while (rawInRange > 0 && double(rawInRange) * units > maxRange) rawInRange--;
+	// A ray meets the ground within the range only where down < thrDown:
+	// elsewhere t = mh / down is <= 0 (down >= 0) or, for mh / maxRange <= down
+	// < 0, beyond the range (with a margin far above the round-off of t). The
+	// test needs no division, so a vector loop clears most pixels.
+	const float thrDown = float(double(mh) / maxRange * (1.0 - 1e-4));
+	if (m_rowCandidate.size() < size_t(cols)) m_rowCandidate.resize(size_t(cols));
+
 	for (int r = 0; r < img.rows; r += step)
 	{
 		const float* __restrict fyRow = projector.rayYRow(r);
 		const float* __restrict fzRow = projector.rayZRow(r);
-		float* __restrict T = m_rowT.data();
-		float* __restrict CX = m_rowCx.data();
-		float* __restrict CY = m_rowCy.data();
-		for (int c = 0; c < cols; c++)
-		{
+		const uint16_t* __restrict raw = img.data + size_t(r) * img.stride;
+		int prev = 0;  // previous pixel of the row: 0 none, 1 seen floor, 2 empty on seen floor
+		const bool statsRow = (r / step) % m_params.stats_row_step == 0;
+		// One pixel whose ray may meet the ground within the range.
+		const auto judgeRay = [&](int c) {
+			const int before = prev;
+			prev = 0;
 			const float fy = fyRow[c], fz = fzRow[c];
 			const float down = n0 + n1 * fy + n2 * fz;
 			// mh < 0: rays going down (down < 0) meet the ground at t > 0; rays
-			// parallel to it or rising get t <= 0 (or -inf), which the next
-			// loop skips. No branch, so the loop vectorizes.
-			const float t = mh / down;
-			T[c] = t;
-			CX[c] = bx + t * (X0 + X1 * fy + X2 * fz);
-			CY[c] = by + t * (Y0 + Y1 * fy + Y2 * fz);
-		}
-		int prev = 0;  // previous pixel of the row: 0 none, 1 seen floor, 2 empty on seen floor
-		const bool statsRow = (r / step) % m_params.stats_row_step == 0;
-		for (int c = 0; c < cols; c += step)
-		{
-			const uint16_t v = img.at(r, c);
-			// Outside the statistics rows only empty rays matter: a return
-			// within the range is never one.
-			if (!statsRow && v != 0 && double(v) * units <= maxRange) continue;
-			const int before = prev;
-			prev = 0;
-			const double t = T[c];  // depth at which the ray meets the ground
+			// parallel to it or rising get t <= 0 (or -inf).
+			const double t = mh / down;  // depth at which the ray meets the ground
 			// (A range along the ray is >= the depth t: t beyond the range is too.)
-			if (!(t > 0) || t > maxRange) continue;
+			if (!(t > 0) || t > maxRange) return;
 			double expected = t;  // in the image's own measure
 			if (!img.is_depth)
 			{
-				const double fy = fyRow[c], fz = fzRow[c];
-				expected = t * std::sqrt(1.0 + fy * fy + fz * fz);
+				const double fyd = fy, fzd = fz;
+				expected = t * std::sqrt(1.0 + fyd * fyd + fzd * fzd);
 			}
-			if (expected < m_params.min_range || expected > maxRange) continue;
-			if (!(CX[c] >= 0.f && CY[c] >= 0.f)) continue;
-			const int cx = int(CX[c]), cy = int(CY[c]);
-			if (cx >= g.nx || cy >= g.ny) continue;
+			if (expected < m_params.min_range || expected > maxRange) return;
+			// The map point s + t R (1, fy, fz), as fractional cell indices
+			// (float is plenty for a cell index).
+			const float tf = float(t);
+			const float cxf = bx + tf * (X0 + X1 * fy + X2 * fz), cyf = by + tf * (Y0 + Y1 * fy + Y2 * fz);
+			if (!(cxf >= 0.f && cyf >= 0.f)) return;
+			const int cx = int(cxf), cy = int(cyf);
+			if (cx >= g.nx || cy >= g.ny) return;
+			const uint16_t v = raw[c];
 			const double got = double(v) * units;
 			const bool empty = v == 0 || (got > maxRange && got > expected + m_params.beyond_margin);
 			if (statsRow) stats.rays++;
@@ -168,10 +165,50 @@ void MissingFloorDetector::compute(
 					if (empty) pairsBothEmpty++;
 				}
 			}
-			if (!empty) continue;
+			if (!empty) return;
 			if (m_empty[cell] == 0) m_touched.push_back(cell);
 			if (m_empty[cell] < 65535) m_empty[cell]++;
+		};
+		// The candidates: rays that may meet the ground within the range and,
+		// outside the statistics rows (where only empty rays matter), that
+		// are empty: no return, or one beyond the range.
+		const auto candidate = [&](int c) {
+			const bool meets = n0 + n1 * fyRow[c] + n2 * fzRow[c] < thrDown;
+			return uint8_t(meets & (statsRow | (uint16_t(raw[c] - 1) >= rawInRange)));
+		};
+		if (step != 1)
+		{
+			for (int c = 0; c < cols; c += step)
+				if (candidate(c))
+					judgeRay(c);
+				else
+					prev = 0;
+			continue;
 		}
+		uint8_t* __restrict isCandidate = m_rowCandidate.data();
+		for (int c = 0; c < cols; c++) isCandidate[c] = candidate(c);
+		// They are few: skip eight pixels without one at a time.
+		int c = 0;
+		for (; c + 8 <= cols; c += 8)
+		{
+			uint64_t eight;
+			std::memcpy(&eight, isCandidate + c, 8);
+			if (!eight)
+			{
+				prev = 0;
+				continue;
+			}
+			for (int j = c; j < c + 8; j++)
+				if (isCandidate[j])
+					judgeRay(j);
+				else
+					prev = 0;
+		}
+		for (; c < cols; c++)
+			if (isCandidate[c])
+				judgeRay(c);
+			else
+				prev = 0;
 	}
 	if (pairsAfterEmpty) m_p11 = double(pairsBothEmpty) / double(pairsAfterEmpty);
 

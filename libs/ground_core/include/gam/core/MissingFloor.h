@@ -162,9 +162,8 @@ class MissingFloorDetector
 	std::vector<uint32_t> m_touched, m_cells, m_blocking, m_queue, m_region;
 	std::vector<uint32_t> m_binRays, m_binEmpty;
 	double m_p11 = -1;
-	// One image row: depth at which each ray meets the ground and the
-	// (fractional) grid cell it meets there; computed in a vectorizable loop.
-	std::vector<float> m_rowT, m_rowCx, m_rowCy;
+	// One image row: 1 for each pixel that needs judging (see compute()).
+	std::vector<uint8_t> m_rowCandidate;
 };
 
 }  // namespace gam
