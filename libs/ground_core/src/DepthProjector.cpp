@@ -318,26 +318,16 @@ size_t DepthProjector::project(
 			projectRowDecimated(
 				p, img.is_depth, row, &m_rayY[lutRow], &m_rayZ[lutRow], &m_rayInvNorm[lutRow], img.cols, dec, rowCell,
 				rowZ);
-		// Compaction: every pixel is written at outCell[n], only the valid ones
-		// advance n (branch-free: valid and invalid pixels interleave at random).
-		const int used = int(colsUsed);
+		// Only the valid pixels (and, with the filter, the ones it keeps) go out.
+		const uint8_t* kept = nullptr;
 		if (f.drop_flying_pixels)
 		{
 			markFlyingRow(img, r, dec, flyTol, useAvx2, keep);
-			for (int k = 0; k < used; k++)
-			{
-				outCell[n] = uint32_t(rowCell[k]);
-				outZ[n] = rowZ[k];
-				n += size_t(rowCell[k] >= 0) & size_t(keep[k]);
-			}
+			kept = keep;
 		}
-		else
-			for (int k = 0; k < used; k++)
-			{
-				outCell[n] = uint32_t(rowCell[k]);
-				outZ[n] = rowZ[k];
-				n += size_t(rowCell[k] >= 0);
-			}
+		const int used = int(colsUsed);
+		n = useAvx2 ? detail::compactRowAvx2(rowCell, rowZ, kept, used, outCell, outZ, n)
+					: compactRow(rowCell, rowZ, kept, used, outCell, outZ, n);
 	}
 	out.commit(n);
 	return n - start;

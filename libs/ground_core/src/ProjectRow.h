@@ -32,6 +32,8 @@ void projectRowAvx2(
 void flyingCandidatesAvx2(
 	const uint16_t* u2, const uint16_t* u1, const uint16_t* row, const uint16_t* d1, const uint16_t* d2, int cols,
 	int t, int h, uint8_t* keep);
+size_t compactRowAvx2(
+	const int32_t* cell, const float* z, const uint8_t* keep, int cols, uint32_t* outCell, float* outZ, size_t n);
 }  // namespace detail
 
 namespace
@@ -76,6 +78,31 @@ inline void projectRow(
 		projectRowLoop<true>(p, row, ky, kz, invNorm, cols, cell, z);
 	else
 		projectRowLoop<false>(p, row, ky, kz, invNorm, cols, cell, z);
+}
+
+// Compaction of a projected row: every pixel is written at outCell[n], only
+// the kept ones (cell >= 0 and, with a filter, keep & 1) advance n
+// (branch-free: kept and dropped pixels interleave at random). keep may be
+// null. Returns the new n; writes up to cols slots from the old n on.
+inline size_t compactRow(
+	const int32_t* __restrict cell, const float* __restrict z, const uint8_t* __restrict keep, int cols,
+	uint32_t* __restrict outCell, float* __restrict outZ, size_t n)
+{
+	if (keep)
+		for (int k = 0; k < cols; k++)
+		{
+			outCell[n] = uint32_t(cell[k]);
+			outZ[n] = z[k];
+			n += size_t(cell[k] >= 0) & size_t(keep[k]);
+		}
+	else
+		for (int k = 0; k < cols; k++)
+		{
+			outCell[n] = uint32_t(cell[k]);
+			outZ[n] = z[k];
+			n += size_t(cell[k] >= 0);
+		}
+	return n;
 }
 
 // The flying-pixel filter's first pass over a row (rows u2, u1 above it, d1,
