@@ -77,6 +77,11 @@ size_t compactRowAvx2(
 	}
 	return compactRow(cell + k, z + k, keep ? keep + k : nullptr, cols - k, outCell, outZ, n);
 }
+
+void flyingLinesAvx2(const float* lines, size_t stride, int count, float tol, uint8_t* along, uint8_t* againstNothing)
+{
+	flyingLines(lines, stride, count, tol, along, againstNothing);
+}
 #else
 bool avx2RowLoopAvailable() { return false; }
 void projectRowAvx2(
@@ -88,5 +93,6 @@ void flyingCandidatesAvx2(
 {
 }
 size_t compactRowAvx2(const int32_t*, const float*, const uint8_t*, int, uint32_t*, float*, size_t n) { return n; }
+void flyingLinesAvx2(const float*, size_t, int, float, uint8_t*, uint8_t*) {}
 #endif
 }  // namespace gam::detail

@@ -6,6 +6,8 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 
@@ -34,6 +36,7 @@ void flyingCandidatesAvx2(
 	int t, int h, uint8_t* keep);
 size_t compactRowAvx2(
 	const int32_t* cell, const float* z, const uint8_t* keep, int cols, uint32_t* outCell, float* outZ, size_t n);
+void flyingLinesAvx2(const float* lines, size_t stride, int count, float tol, uint8_t* along, uint8_t* againstNothing);
 }  // namespace detail
 
 namespace
@@ -78,6 +81,107 @@ inline void projectRow(
 		projectRowLoop<true>(p, row, ky, kz, invNorm, cols, cell, z);
 	else
 		projectRowLoop<false>(p, row, ky, kz, invNorm, cols, cell, z);
+}
+
+// --- The flying-pixel rule (DepthProjector::isFlyingPixel) ---
+// Each test reads one line of the image through the pixel (a row or a
+// column): the depths v[0..6] at offsets -3 ... +3 steps (0 outside the
+// image), the pixel at v[3]. Written with & and | (every part evaluated, no
+// branch) so that a batch of candidates runs as a vector loop
+// (flyingLines); the answers are those of the short-circuit form.
+
+// Whether the surface through `far` and `near` (the two pixels on one side,
+// `near` the adjacent one) continues to depth d within tol: on a plane the
+// inverse depth is affine in the pixel coordinates. (Without a return on
+// that side, no: the quotients of a 0 are then never used.)
+inline bool continues(float far, float near, float d, float tol)
+{
+	const float inv = 2.0f / near - 1.0f / far;
+	return (far > 0) & (near > 0) & (inv > 0) & (std::abs(1.0f / inv - d) <= tol);
+}
+
+// Strictly between a and b, more than tol from each.
+inline bool between(float a, float d, float b, float tol)
+{
+	return (a > 0) & (b > 0) & ((d - a) * (b - d) > 0) & (std::abs(d - a) > tol) & (std::abs(d - b) > tol);
+}
+
+// Relative depth jump from the near side that a pixel next to a no-return
+// must show to count as flying (see againstNothingAlong).
+constexpr float kAgainstNothingJump = 0.05f;
+
+// Mixed pixels come alone or in pairs (both sides of an edge can mix): a
+// pair is two pixels within tol of each other, between the pixels around
+// it, that continues neither side.
+inline bool flyingAlong(const float* v, float tol)
+{
+	const float d = v[3];
+	const bool leftContinues = continues(v[1], v[2], d, tol), rightContinues = continues(v[5], v[4], d, tol);
+	const bool alone = between(v[2], d, v[4], tol) & !leftContinues & !rightContinues;
+	const bool pairedWithNext = (std::abs(v[4] - d) <= tol) & between(v[2], d, v[5], tol) &
+								between(v[2], v[4], v[5], tol) & !leftContinues & !continues(v[6], v[5], v[4], tol);
+	const bool pairedWithPrevious = (std::abs(v[2] - d) <= tol) & between(v[1], d, v[4], tol) &
+									between(v[1], v[2], v[4], tol) & !continues(v[0], v[1], v[2], tol) &
+									!rightContinues;
+	return alone | pairedWithNext | pairedWithPrevious;
+}
+
+// Against no return, along one line: the background behind an edge beyond
+// the range (or absorbing) returns nothing, but the mixed pixel still lies
+// between the edge and that background. One side has no return, the other
+// is nearer by more than tol and by more than kAgainstNothingJump of d, and d
+// continues neither the near side nor a return just past the gap. (With only
+// one side to compare with, the jump must also exceed what noise makes
+// between two pixels of one surface: at most 4.2 % at p99.99 on simulated
+// Kinect One frames, up to 78 deg incidence at 4.5 m; with tol alone, far
+// floor next to a dropout was dropped, 700 pixels a frame.)
+inline bool againstNothingAlong(const float* v, float tol)
+{
+	const float d = v[3], jump = std::max(tol, kAgainstNothingJump * d);
+	const auto one = [&](float nearFar, float nearNext, float gap, float beyond) {
+		return (gap == 0) & (nearNext > 0) & (d - nearNext > jump) & !continues(nearFar, nearNext, d, tol) &
+			   !((beyond > 0) & (std::abs(beyond - d) <= tol));
+	};
+	return one(v[1], v[2], v[4], v[5]) | one(v[5], v[4], v[2], v[1]);
+}
+
+// What flyingAlong or againstNothingAlong needs along a line: a neighbour
+// (+-1, +-2) with a return nearer than the pixel by more than t and, unless
+// a pixel next to it has no return, one farther by more than t (t = tol
+// rounded down: the depths are whole image units). Cheap, and false for
+// most pixels: the full tests run only where it holds.
+inline bool spreadAlong(const float* v, float t)
+{
+	const float d = v[3];
+	bool nearer = false, farther = false;
+	for (int o : {1, 2, 4, 5})
+	{
+		nearer |= (v[o] > 0) & (v[o] < d - t);
+		farther |= v[o] > d + t;
+	}
+	return nearer & (farther | (v[2] == 0) | (v[4] == 0));
+}
+
+// For a batch of pixels, the two lines of each (lines[o * stride + k]: row
+// line o = 0..6, column line o = 7..13, of pixel k): along[k] =
+// flyingAlong on either line, againstNothing[k] = againstNothingAlong on
+// either line. A vector loop: every pixel pays for every division, 8 at a
+// time, instead of the mispredicted branches of one pixel at a time.
+inline void flyingLines(
+	const float* __restrict lines, size_t stride, int count, float tol, uint8_t* __restrict along,
+	uint8_t* __restrict againstNothing)
+{
+	for (int k = 0; k < count; k++)
+	{
+		float h[7], w[7];
+		for (int o = 0; o < 7; o++)
+		{
+			h[o] = lines[size_t(o) * stride + size_t(k)];
+			w[o] = lines[size_t(o + 7) * stride + size_t(k)];
+		}
+		along[k] = uint8_t(flyingAlong(h, tol) | flyingAlong(w, tol));
+		againstNothing[k] = uint8_t(againstNothingAlong(h, tol) | againstNothingAlong(w, tol));
+	}
 }
 
 // Compaction of a projected row: every pixel is written at outCell[n], only
