@@ -162,8 +162,11 @@ class MissingFloorDetector
 	std::vector<uint32_t> m_touched, m_cells, m_blocking, m_queue, m_region;
 	std::vector<uint32_t> m_binRays, m_binEmpty;
 	double m_p11 = -1;
-	// One image row: 1 for each pixel that needs judging (see compute()).
+	// One image row: 1 for each pixel that needs judging, and the depth at
+	// which each ray meets the ground and the (fractional) grid cell it meets
+	// there (see compute()).
 	std::vector<uint8_t> m_rowCandidate;
+	std::vector<float> m_rowT, m_rowCx, m_rowCy;
 };
 
 }  // namespace gam
