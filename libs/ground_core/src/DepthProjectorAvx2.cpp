@@ -26,7 +26,33 @@ void flyingCandidatesAvx2(
 	const uint16_t* u2, const uint16_t* u1, const uint16_t* row, const uint16_t* d1, const uint16_t* d2, int cols,
 	int t, int h, uint8_t* keep)
 {
-	flyingCandidates(u2, u1, row, d1, d2, cols, t, h, keep);
+	// flyingCandidates, but a block of 16 pixels where no pixel with a return
+	// differs by more than t from a neighbour in its row or its column (most
+	// of a smooth surface) keeps all 16 without the full pass: both its lines
+	// are calm there (dl <= t and dr <= t).
+	uint16_t T, H;
+	flyingCandidateLimits(t, h, T, H);
+	keep[0] = keep[1] = keep[cols - 2] = keep[cols - 1] = 0;
+	const __m256i limit = _mm256_set1_epi16(static_cast<short>(T)), zero = _mm256_setzero_si256();
+	const auto load = [](const uint16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); };
+	// Lanes where |a - b| > T are non-zero.
+	const auto jump = [&](__m256i a, __m256i b) {
+		return _mm256_subs_epu16(_mm256_or_si256(_mm256_subs_epu16(a, b), _mm256_subs_epu16(b, a)), limit);
+	};
+	int c = 2;
+	for (; c + 16 <= cols - 2; c += 16)
+	{
+		const __m256i x = load(row + c);
+		const __m256i jumps = _mm256_or_si256(
+			_mm256_or_si256(jump(x, load(row + c - 1)), jump(x, load(row + c + 1))),
+			_mm256_or_si256(jump(x, load(u1 + c)), jump(x, load(d1 + c))));
+		const __m256i busy = _mm256_andnot_si256(_mm256_cmpeq_epi16(x, zero), jumps);
+		if (_mm256_testz_si256(busy, busy))
+			_mm_storeu_si128(reinterpret_cast<__m128i*>(keep + c), _mm_set1_epi8(1));
+		else
+			flyingCandidatesIn(u2, u1, row, d1, d2, c, c + 16, T, H, keep);
+	}
+	flyingCandidatesIn(u2, u1, row, d1, d2, c, cols - 2, T, H, keep);
 }
 
 namespace

@@ -220,11 +220,14 @@ inline size_t compactRow(
 // tested as (e + h) mod 2^16 <= 2 h, which can wrongly clear a pixel only
 // when |2 p1 - p2 - x| >= 2^16 - h, i.e. for depths over 2^15 units (33 m
 // in millimetres); it never makes a kept pixel a candidate.
-inline void flyingCandidates(
+// keep[c] for begin <= c < end (2 <= begin, end <= cols - 2), with T = t and
+// H = h clamped (flyingCandidateLimits).
+inline void flyingCandidatesIn(
 	const uint16_t* __restrict u2, const uint16_t* __restrict u1, const uint16_t* __restrict row,
-	const uint16_t* __restrict d1, const uint16_t* __restrict d2, int cols, int t, int h, uint8_t* __restrict keep)
+	const uint16_t* __restrict d1, const uint16_t* __restrict d2, int begin, int end, uint16_t T, uint16_t H,
+	uint8_t* __restrict keep)
 {
-	const uint16_t T = uint16_t(std::min(t, 65535)), H = uint16_t(std::min(h, 16383)), H2 = uint16_t(2 * H);
+	const uint16_t H2 = uint16_t(2 * H);
 	auto calm = [&](uint16_t p2, uint16_t p1, uint16_t x, uint16_t n1, uint16_t n2) -> uint16_t {
 		const uint16_t el = uint16_t(uint16_t(2 * p1 - p2 - x) + H), er = uint16_t(uint16_t(2 * n1 - n2 - x) + H);
 		const uint16_t dl = uint16_t(x > p1 ? x - p1 : p1 - x), dr = uint16_t(x > n1 ? x - n1 : n1 - x);
@@ -235,13 +238,29 @@ inline void flyingCandidates(
 		const uint16_t nearL = (p1 != 0) & (x > p1) & (dl > T), nearR = (n1 != 0) & (x > n1) & (dr > T);
 		return uint16_t(contL | contR | ((dl <= T) & (dr <= T)) | ((p1 == 0) & !nearR) | ((n1 == 0) & !nearL));
 	};
-	keep[0] = keep[1] = keep[cols - 2] = keep[cols - 1] = 0;
-	for (int c = 2; c < cols - 2; c++)
+	for (int c = begin; c < end; c++)
 	{
 		const uint16_t x = row[c];
 		keep[c] = uint8_t(
 			(calm(row[c - 2], row[c - 1], x, row[c + 1], row[c + 2]) & calm(u2[c], u1[c], x, d1[c], d2[c])) | (x == 0));
 	}
+}
+
+// T and H of flyingCandidatesIn from the tolerances t and h.
+inline void flyingCandidateLimits(int t, int h, uint16_t& T, uint16_t& H)
+{
+	T = uint16_t(std::min(t, 65535));
+	H = uint16_t(std::min(h, 16383));
+}
+
+inline void flyingCandidates(
+	const uint16_t* __restrict u2, const uint16_t* __restrict u1, const uint16_t* __restrict row,
+	const uint16_t* __restrict d1, const uint16_t* __restrict d2, int cols, int t, int h, uint8_t* __restrict keep)
+{
+	uint16_t T, H;
+	flyingCandidateLimits(t, h, T, H);
+	keep[0] = keep[1] = keep[cols - 2] = keep[cols - 1] = 0;
+	flyingCandidatesIn(u2, u1, row, d1, d2, 2, cols - 2, T, H, keep);
 }
 }  // namespace
 }  // namespace gam
