@@ -33,6 +33,10 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 	m_rowCell.resize(size_t(K.width));
 	m_rowZ.resize(size_t(K.width));
 	m_rowKeep.resize(size_t(K.width));
+	m_flyCols.resize(size_t(K.width));
+	m_flyLines.resize(14 * size_t(K.width));
+	m_flyAlong.resize(size_t(K.width));
+	m_flyAgainstNothing.resize(size_t(K.width));
 	const bool distorted = K.k1 != 0 || K.k2 != 0 || K.k3 != 0 || K.p1 != 0 || K.p2 != 0;
 	for (int r = 0; r < K.height; r++)
 	{
@@ -89,63 +93,6 @@ void projectRowDecimated(
 			projectPixel<false>(p, row[c], ky[c], kz[c], invNorm[c], cell[k], z[k]);
 	}
 }
-// Whether the surface through `far` and `near` (the two pixels on one side,
-// `near` the adjacent one) continues to depth d within tol: on a plane the
-// inverse depth is affine in the pixel coordinates.
-inline bool continues(float far, float near, float d, float tol)
-{
-	if (!(far > 0) || !(near > 0)) return false;
-	const float inv = 2.0f / near - 1.0f / far;
-	return inv > 0 && std::abs(1.0f / inv - d) <= tol;
-}
-
-// Strictly between a and b, more than tol from each.
-inline bool between(float a, float d, float b, float tol)
-{
-	return a > 0 && b > 0 && (d - a) * (b - d) > 0 && std::abs(d - a) > tol && std::abs(d - b) > tol;
-}
-
-// Relative depth jump from the near side that a pixel next to a no-return
-// must show to count as flying (see againstNothingAlong).
-constexpr float kAgainstNothingJump = 0.05f;
-
-// Along one line of the image (a row or a column), the values v[0..6] at
-// offsets -3 ... +3 steps (0 outside the image): see
-// DepthProjector::isFlyingPixel. Mixed pixels come alone or in pairs (both
-// sides of an edge can mix): a pair is two pixels within tol of each other,
-// between the pixels around it, that continues neither side.
-bool flyingAlong(const float* v, float tol)
-{
-	const float d = v[3];
-	if (between(v[2], d, v[4], tol) && !continues(v[1], v[2], d, tol) && !continues(v[5], v[4], d, tol)) return true;
-	// paired with the next pixel
-	if (std::abs(v[4] - d) <= tol && between(v[2], d, v[5], tol) && between(v[2], v[4], v[5], tol) &&
-		!continues(v[1], v[2], d, tol) && !continues(v[6], v[5], v[4], tol))
-		return true;
-	// paired with the previous pixel
-	return std::abs(v[2] - d) <= tol && between(v[1], d, v[4], tol) && between(v[1], v[2], v[4], tol) &&
-		   !continues(v[0], v[1], v[2], tol) && !continues(v[5], v[4], d, tol);
-}
-
-// Against no return, along one line: the background behind an edge beyond
-// the range (or absorbing) returns nothing, but the mixed pixel still lies
-// between the edge and that background. One side has no return, the other
-// is nearer by more than tol and by more than kAgainstNothingJump of d, and d
-// continues neither the near side nor a return just past the gap. (With only
-// one side to compare with, the jump must also exceed what noise makes
-// between two pixels of one surface: at most 4.2 % at p99.99 on simulated
-// Kinect One frames, up to 78 deg incidence at 4.5 m; with tol alone, far
-// floor next to a dropout was dropped, 700 pixels a frame.)
-bool againstNothingAlong(const float* v, float tol)
-{
-	const float d = v[3];
-	auto one = [&](float nearFar, float nearNext, float gap, float beyond) {
-		return gap == 0 && nearNext > 0 && d - nearNext > std::max(tol, kAgainstNothingJump * d) &&
-			   !continues(nearFar, nearNext, d, tol) && !(beyond > 0 && std::abs(beyond - d) <= tol);
-	};
-	return one(v[1], v[2], v[4], v[5]) || one(v[5], v[4], v[2], v[1]);
-}
-
 // A neighbour along the line within tol of the pixel: it lies on a surface
 // there (the far floor just past a step's edge continues along its row while
 // the column beyond it drops out; a mixed pixel has no such neighbour).
@@ -182,6 +129,10 @@ bool flyingAt(const RangeImageView& img, int r, int c, int step, float tol)
 			w[o + 3] = v(r + o * step, c);
 		}
 	}
+	// Neither test can hold without a spread along one of the lines (most
+	// pixels have none).
+	const float wholeTol = std::floor(tol);
+	if (!spreadAlong(h, wholeTol) && !spreadAlong(w, wholeTol)) return false;
 	if (flyingAlong(h, tol) || flyingAlong(w, tol)) return true;
 	if (!againstNothingAlong(h, tol) && !againstNothingAlong(w, tol)) return false;
 	// Against no return, a pixel must also stand alone: no neighbour of the
@@ -203,12 +154,26 @@ bool flyingAt(const RangeImageView& img, int r, int c, int step, float tol)
 	return true;
 }
 
+// Scratch of markFlyingRow for one row's candidates (room for a row each):
+// their columns, their two lines (14 floats each, see flyingLines) and the
+// answers of the two tests.
+struct FlyingBatch
+{
+	int32_t* cols;
+	float* lines;
+	size_t stride;
+	uint8_t* along;
+	uint8_t* againstNothing;
+};
+
 // Marks the flying pixels of row r (every dec-th column) in keep[k] = 0.
 // Inside the image (dec = 1) a vector pass (flyingCandidates, ProjectRow.h)
 // clears every pixel that cannot be flying; only the few candidates left get
-// the full test (flyingAt). Near the borders and with decimation, every
-// pixel gets the full test.
-void markFlyingRow(const RangeImageView& img, int r, int dec, float tol, bool avx2, uint8_t* keep)
+// the full test: at least 3 pixels from the border, in one vector loop over
+// the row's candidates (flyingLines), elsewhere flyingAt. Near the borders
+// and with decimation, every pixel gets flyingAt.
+void markFlyingRow(
+	const RangeImageView& img, int r, int dec, float tol, bool avx2, uint8_t* keep, const FlyingBatch& batch)
 {
 	const int cols = img.cols, used = (cols + dec - 1) / dec;
 	if (dec != 1 || cols < 5 || r < 2 || r + 2 >= img.rows)
@@ -224,7 +189,25 @@ void markFlyingRow(const RangeImageView& img, int r, int dec, float tol, bool av
 		detail::flyingCandidatesAvx2(u2, u1, row, d1, d2, cols, t, h, keep);
 	else
 		flyingCandidates(u2, u1, row, d1, d2, cols, t, h, keep);
-	// The candidates are few: skip 8 kept pixels at a time.
+	// The candidates are few: skip 8 kept pixels at a time. Gather the lines
+	// of those with three pixels of image on every side.
+	const bool innerRow = r >= 3 && r + 3 < img.rows;
+	const ptrdiff_t down = ptrdiff_t(img.stride);
+	int count = 0;
+	const auto visit = [&](int c) {
+		if (!innerRow || c < 3 || c + 3 >= cols)
+		{
+			keep[c] = uint8_t(!flyingAt(img, r, c, 1, tol));
+			return;
+		}
+		const uint16_t* p = row + c;
+		for (int o = -3; o <= 3; o++)
+		{
+			batch.lines[size_t(o + 3) * batch.stride + size_t(count)] = float(p[o]);
+			batch.lines[size_t(o + 10) * batch.stride + size_t(count)] = float(p[o * down]);
+		}
+		batch.cols[count++] = c;
+	};
 	int k = 0;
 	for (; k + 8 <= cols; k += 8)
 	{
@@ -232,10 +215,20 @@ void markFlyingRow(const RangeImageView& img, int r, int dec, float tol, bool av
 		std::memcpy(&eight, keep + k, 8);
 		if (eight == 0x0101010101010101ull) continue;
 		for (int j = k; j < k + 8; j++)
-			if (!keep[j]) keep[j] = uint8_t(!flyingAt(img, r, j, 1, tol));
+			if (!keep[j]) visit(j);
 	}
 	for (; k < cols; k++)
-		if (!keep[k]) keep[k] = uint8_t(!flyingAt(img, r, k, 1, tol));
+		if (!keep[k]) visit(k);
+	if (avx2)
+		detail::flyingLinesAvx2(batch.lines, batch.stride, count, tol, batch.along, batch.againstNothing);
+	else
+		flyingLines(batch.lines, batch.stride, count, tol, batch.along, batch.againstNothing);
+	// Against no return (rare), a pixel must also stand alone: flyingAt.
+	for (int i = 0; i < count; i++)
+	{
+		const int c = batch.cols[i];
+		keep[c] = batch.along[i] ? 0 : !batch.againstNothing[i] ? 1 : uint8_t(!flyingAt(img, r, c, 1, tol));
+	}
 }
 }  // namespace
 
@@ -300,6 +293,8 @@ size_t DepthProjector::project(
 	// by less than a cell), in image units.
 	const float flyTol = float(g.resolution / double(img.units));
 	uint8_t* keep = m_rowKeep.data();
+	const FlyingBatch flyingBatch{
+		m_flyCols.data(), m_flyLines.data(), size_t(K.width), m_flyAlong.data(), m_flyAgainstNothing.data()};
 
 	for (int r = 0; r < img.rows; r += dec)
 	{
@@ -318,26 +313,16 @@ size_t DepthProjector::project(
 			projectRowDecimated(
 				p, img.is_depth, row, &m_rayY[lutRow], &m_rayZ[lutRow], &m_rayInvNorm[lutRow], img.cols, dec, rowCell,
 				rowZ);
-		// Compaction: every pixel is written at outCell[n], only the valid ones
-		// advance n (branch-free: valid and invalid pixels interleave at random).
-		const int used = int(colsUsed);
+		// Only the valid pixels (and, with the filter, the ones it keeps) go out.
+		const uint8_t* kept = nullptr;
 		if (f.drop_flying_pixels)
 		{
-			markFlyingRow(img, r, dec, flyTol, useAvx2, keep);
-			for (int k = 0; k < used; k++)
-			{
-				outCell[n] = uint32_t(rowCell[k]);
-				outZ[n] = rowZ[k];
-				n += size_t(rowCell[k] >= 0) & size_t(keep[k]);
-			}
+			markFlyingRow(img, r, dec, flyTol, useAvx2, keep, flyingBatch);
+			kept = keep;
 		}
-		else
-			for (int k = 0; k < used; k++)
-			{
-				outCell[n] = uint32_t(rowCell[k]);
-				outZ[n] = rowZ[k];
-				n += size_t(rowCell[k] >= 0);
-			}
+		const int used = int(colsUsed);
+		n = useAvx2 ? detail::compactRowAvx2(rowCell, rowZ, kept, used, outCell, outZ, n)
+					: compactRow(rowCell, rowZ, kept, used, outCell, outZ, n);
 	}
 	out.commit(n);
 	return n - start;

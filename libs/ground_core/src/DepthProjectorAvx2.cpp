@@ -4,6 +4,10 @@
 // SSE2 loop and maps do not depend on the CPU. DepthProjector.cpp calls it only when the CPU has AVX2.
 #include "ProjectRow.h"
 
+#if defined(GAM_HAVE_AVX2_ROW_LOOP)
+#include <immintrin.h>
+#endif
+
 namespace gam::detail
 {
 #if defined(GAM_HAVE_AVX2_ROW_LOOP)
@@ -22,7 +26,87 @@ void flyingCandidatesAvx2(
 	const uint16_t* u2, const uint16_t* u1, const uint16_t* row, const uint16_t* d1, const uint16_t* d2, int cols,
 	int t, int h, uint8_t* keep)
 {
-	flyingCandidates(u2, u1, row, d1, d2, cols, t, h, keep);
+	// flyingCandidates, but a block of 16 pixels where no pixel with a return
+	// differs by more than t from a neighbour in its row or its column (most
+	// of a smooth surface) keeps all 16 without the full pass: both its lines
+	// are calm there (dl <= t and dr <= t).
+	uint16_t T, H;
+	flyingCandidateLimits(t, h, T, H);
+	keep[0] = keep[1] = keep[cols - 2] = keep[cols - 1] = 0;
+	const __m256i limit = _mm256_set1_epi16(static_cast<short>(T)), zero = _mm256_setzero_si256();
+	const auto load = [](const uint16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); };
+	// Lanes where |a - b| > T are non-zero.
+	const auto jump = [&](__m256i a, __m256i b) {
+		return _mm256_subs_epu16(_mm256_or_si256(_mm256_subs_epu16(a, b), _mm256_subs_epu16(b, a)), limit);
+	};
+	int c = 2;
+	for (; c + 16 <= cols - 2; c += 16)
+	{
+		const __m256i x = load(row + c);
+		const __m256i jumps = _mm256_or_si256(
+			_mm256_or_si256(jump(x, load(row + c - 1)), jump(x, load(row + c + 1))),
+			_mm256_or_si256(jump(x, load(u1 + c)), jump(x, load(d1 + c))));
+		const __m256i busy = _mm256_andnot_si256(_mm256_cmpeq_epi16(x, zero), jumps);
+		if (_mm256_testz_si256(busy, busy))
+			_mm_storeu_si128(reinterpret_cast<__m128i*>(keep + c), _mm_set1_epi8(1));
+		else
+			flyingCandidatesIn(u2, u1, row, d1, d2, c, c + 16, T, H, keep);
+	}
+	flyingCandidatesIn(u2, u1, row, d1, d2, c, cols - 2, T, H, keep);
+}
+
+namespace
+{
+// Left-packing 8 lanes: for each 8-bit mask of kept lanes, the indices of the
+// kept lanes first (one byte each), and how many there are.
+struct PackTable
+{
+	uint64_t lanes[256] = {};
+	uint8_t count[256] = {};
+	constexpr PackTable()
+	{
+		for (int m = 0; m < 256; m++)
+		{
+			int j = 0;
+			for (int b = 0; b < 8; b++)
+				if (m >> b & 1) lanes[m] |= uint64_t(b) << (8 * j++);
+			count[m] = uint8_t(j);
+		}
+	}
+};
+constexpr PackTable kPack{};
+}  // namespace
+
+size_t compactRowAvx2(
+	const int32_t* cell, const float* z, const uint8_t* keep, int cols, uint32_t* outCell, float* outZ, size_t n)
+{
+	// compactRow 8 pixels at a time: the kept ones are moved to the front of
+	// the 8 lanes and all 8 stored at outCell[n] (the slots past the kept
+	// ones are scratch, as in compactRow). Same output.
+	const __m256i minusOne = _mm256_set1_epi32(-1), one = _mm256_set1_epi32(1), zero = _mm256_setzero_si256();
+	int k = 0;
+	for (; k + 8 <= cols; k += 8)
+	{
+		const __m256i c = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + k));
+		const __m256 zz = _mm256_loadu_ps(z + k);
+		__m256i kept = _mm256_cmpgt_epi32(c, minusOne);
+		if (keep)
+		{
+			const __m256i bytes = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(keep + k)));
+			kept = _mm256_andnot_si256(_mm256_cmpeq_epi32(_mm256_and_si256(bytes, one), zero), kept);
+		}
+		const unsigned mask = unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(kept)));
+		const __m256i lanes = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(static_cast<long long>(kPack.lanes[mask])));
+		_mm256_storeu_si256(reinterpret_cast<__m256i*>(outCell + n), _mm256_permutevar8x32_epi32(c, lanes));
+		_mm256_storeu_ps(outZ + n, _mm256_permutevar8x32_ps(zz, lanes));
+		n += kPack.count[mask];
+	}
+	return compactRow(cell + k, z + k, keep ? keep + k : nullptr, cols - k, outCell, outZ, n);
+}
+
+void flyingLinesAvx2(const float* lines, size_t stride, int count, float tol, uint8_t* along, uint8_t* againstNothing)
+{
+	flyingLines(lines, stride, count, tol, along, againstNothing);
 }
 #else
 bool avx2RowLoopAvailable() { return false; }
@@ -34,5 +118,7 @@ void flyingCandidatesAvx2(
 	const uint16_t*, const uint16_t*, const uint16_t*, const uint16_t*, const uint16_t*, int, int, int, uint8_t*)
 {
 }
+size_t compactRowAvx2(const int32_t*, const float*, const uint8_t*, int, uint32_t*, float*, size_t n) { return n; }
+void flyingLinesAvx2(const float*, size_t, int, float, uint8_t*, uint8_t*) {}
 #endif
 }  // namespace gam::detail

@@ -28,7 +28,8 @@ void ElevationGrid::resize(const GridGeometry& g)
 	m_cells.assign(g.cellCount(), ElevationCell{});
 	m_frame.assign(g.cellCount(), FrameCell{});
 	m_filterMean.assign(g.cellCount(), 0.f);
-	m_filterLimit.assign(g.cellCount(), std::numeric_limits<float>::infinity());
+	m_filterLimit.assign(g.cellCount(), 0.f);
+	m_flagged.assign(g.cellCount(), 0);
 	m_touched.clear();
 	m_idwTouched.clear();
 	m_frameTouched.clear();
@@ -121,20 +122,22 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 		const float mean = a.ref + m1;
 		if (mean - lim <= a.z_min && mean + lim >= a.z_max) continue;
 		m_filterMean[c] = mean;
-		m_filterLimit[c] = lim;  // finite = flagged
+		m_filterLimit[c] = lim;
+		m_flagged[c] = 1;
 		a = FrameCell{};
 		flagged++;
 	}
 	size_t kept = n;
 	if (flagged)
 	{
-		// Pass 2, only if some cell had outliers: re-accumulate the flagged cells.
+		// Pass 2, only if some cell had outliers: re-accumulate the flagged
+		// cells (a byte per cell tells which: it stays in the L1 cache).
+		const uint8_t* flaggedCell = m_flagged.data();
 		for (size_t i = 0; i < n; i++)
 		{
 			const uint32_t c = cellOf[i];
-			const float lim = m_filterLimit[c];
-			if (lim == std::numeric_limits<float>::infinity()) continue;
-			if (std::abs(zOf[i] - m_filterMean[c]) <= lim)
+			if (!flaggedCell[c]) continue;
+			if (std::abs(zOf[i] - m_filterMean[c]) <= m_filterLimit[c])
 				accumulate(m_frame[c], zOf[i]);
 			else
 				kept--;
@@ -145,7 +148,7 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 	for (uint32_t c : m_frameTouched)
 	{
 		FrameCell& a = m_frame[c];
-		m_filterLimit[c] = std::numeric_limits<float>::infinity();
+		m_flagged[c] = 0;
 		if (a.count)
 		{
 			ElevationCell& gc = m_cells[c];

@@ -274,11 +274,14 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 	// kept (the kept ones are exactly those in [z_min, z_max] of the cell).
 	const ConstSpan<uint32_t> cells = samples.cells();
 	const ConstSpan<float> zs = samples.heights();
-	const size_t nCells = m_tailLo.size();
+	// Most samples lie in other cells (thresholds -inf / +inf): one byte per
+	// cell tells, where the two thresholds are 8 bytes, far apart.
+	for (const TailCandidate& d : m_tailCandidates) m_tailCell[d.cell] = 1;
+	const size_t nCells = m_tailCell.size();
 	for (size_t i = 0; i < cells.size(); i++)
 	{
 		const uint32_t c = cells[i];
-		if (c >= nCells) continue;
+		if (c >= nCells || !m_tailCell[c]) continue;
 		const float z = zs[i];
 		if ((z < m_tailLo[c] && z >= frame.cell(c).z_min) || (z > m_tailHi[c] && z <= frame.cell(c).z_max))
 			m_tailCount[c]++;
@@ -292,6 +295,7 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 		m_tailLo[d.cell] = -std::numeric_limits<float>::infinity();
 		m_tailHi[d.cell] = std::numeric_limits<float>::infinity();
 		m_tailCount[d.cell] = 0;
+		m_tailCell[d.cell] = 0;
 		const ElevationCell& c = frame.cell(d.cell);
 		const float pOcc = obstacleEvidence(c, res);
 		if (d.kind == TailKind::Deep)
@@ -350,6 +354,7 @@ void InverseSensorModel::compute(
 		m_tailLo.assign(g.cellCount(), -std::numeric_limits<float>::infinity());
 		m_tailHi.assign(g.cellCount(), std::numeric_limits<float>::infinity());
 		m_tailCount.assign(g.cellCount(), 0);
+		m_tailCell.assign(g.cellCount(), 0);
 	}
 	for (uint32_t c : m_evidenceCells) m_evidence[c] = 0.5f;
 	m_evidenceCells.clear();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace gam
 {
@@ -46,6 +47,40 @@ double MissingFloorDetector::dropoutRate(double depth) const
 	if (b >= m_binRays.size() || m_binRays[b] == 0) return 1.0;
 	return double(m_binEmpty[b]) / double(m_binRays[b]);
 }
+
+namespace
+{
+// The rays of the ray table against the ground plane, in the frame grid's
+// cell units (see MissingFloorDetector::compute). Float is plenty for a cell
+// index; the row loop and the single pixel use the same expressions, so they
+// give the same floats.
+struct GroundRays
+{
+	float n0, n1, n2;              ///< the plane's normal in the sensor frame: down = n0 + n1 fy + n2 fz
+	float mh;                      ///< minus the sensor's height over the plane (< 0)
+	float bx, by;                  ///< the sensor, in cells
+	float X0, X1, X2, Y0, Y1, Y2;  ///< rows 0 and 1 of the sensor's rotation, per cell
+
+	/** Where the ray (1, fy, fz) meets the ground: depth t (<= 0 or -inf for
+	 * rays parallel to the ground or rising: mh < 0) and the fractional cell
+	 * (cx, cy). */
+	void meet(float fy, float fz, float& t, float& cx, float& cy) const
+	{
+		t = mh / (n0 + n1 * fy + n2 * fz);
+		cx = bx + t * (X0 + X1 * fy + X2 * fz);
+		cy = by + t * (Y0 + Y1 * fy + Y2 * fz);
+	}
+};
+
+// meet() for a whole row (no branch: the loop vectorizes).
+void meetGroundRow(
+	const GroundRays& rays, const float* __restrict fy, const float* __restrict fz, int cols, float* __restrict t,
+	float* __restrict cx, float* __restrict cy)
+{
+	const GroundRays g = rays;
+	for (int c = 0; c < cols; c++) g.meet(fy[c], fz[c], t[c], cx[c], cy[c]);
+}
+}  // namespace
 
 void MissingFloorDetector::compute(
 	const SensorFrame& frame, const DepthProjector& projector, int decimation, double maxRange, const Plane& ground,
@@ -102,63 +137,68 @@ void MissingFloorDetector::compute(
 	// each row, pairs of neighbours that both meet seen floor give p11.
 	size_t pairsAfterEmpty = 0, pairsBothEmpty = 0;
 	const int cols = img.cols;
-	if (int(m_rowT.size()) < cols)
+	// Per ray (1, fy, fz): down = nr.(1, fy, fz), t = -h / down, and the map
+	// point s + t R (1, fy, fz), as fractional cell indices.
+	GroundRays rays;
+	rays.n0 = float(nr.x());
+	rays.n1 = float(nr.y());
+	rays.n2 = float(nr.z());
+	rays.mh = float(-h);
+	const float invRes = float(1.0 / g.resolution);
+	rays.bx = float((s.x() - g.x_min) / g.resolution);
+	rays.by = float((s.y() - g.y_min) / g.resolution);
+	rays.X0 = float(R(0, 0)) * invRes;
+	rays.X1 = float(R(0, 1)) * invRes;
+	rays.X2 = float(R(0, 2)) * invRes;
+	rays.Y0 = float(R(1, 0)) * invRes;
+	rays.Y1 = float(R(1, 1)) * invRes;
+	rays.Y2 = float(R(1, 2)) * invRes;
+	const float n0 = rays.n0, n1 = rays.n1, n2 = rays.n2, mh = rays.mh;
+	// A return within the range is never an empty ray: raw values 1..rawInRange
+	// are exactly those with double(v) * units <= maxRange (monotone in v).
+	uint16_t rawInRange = uint16_t(std::min(65535.0, std::floor(maxRange / double(units))));
+	while (rawInRange < 65535 && double(rawInRange + 1) * units <= maxRange) rawInRange++;
+	while (rawInRange > 0 && double(rawInRange) * units > maxRange) rawInRange--;
+	// A ray meets the ground within the range only where down < thrDown:
+	// elsewhere t = mh / down is <= 0 (down >= 0) or, for mh / maxRange <= down
+	// < 0, beyond the range (with a margin far above the round-off of t). The
+	// test needs no division, so a vector loop clears most pixels.
+	const float thrDown = float(double(mh) / maxRange * (1.0 - 1e-4));
+	if (m_rowCandidate.size() < size_t(cols))
 	{
+		m_rowCandidate.resize(size_t(cols));
 		m_rowT.resize(size_t(cols));
 		m_rowCx.resize(size_t(cols));
 		m_rowCy.resize(size_t(cols));
 	}
-	// Per ray (1, fy, fz): down = nr.(1, fy, fz), t = -h / down, and the map
-	// point s + t R (1, fy, fz), as fractional cell indices. Float is plenty
-	// for a cell index and lets the row loop vectorize.
-	const float n0 = float(nr.x()), n1 = float(nr.y()), n2 = float(nr.z()), mh = float(-h);
-	const float invRes = float(1.0 / g.resolution);
-	const float bx = float((s.x() - g.x_min) / g.resolution), by = float((s.y() - g.y_min) / g.resolution);
-	const float X0 = float(R(0, 0)) * invRes, X1 = float(R(0, 1)) * invRes, X2 = float(R(0, 2)) * invRes;
-	const float Y0 = float(R(1, 0)) * invRes, Y1 = float(R(1, 1)) * invRes, Y2 = float(R(1, 2)) * invRes;
+
 	for (int r = 0; r < img.rows; r += step)
 	{
 		const float* __restrict fyRow = projector.rayYRow(r);
 		const float* __restrict fzRow = projector.rayZRow(r);
-		float* __restrict T = m_rowT.data();
-		float* __restrict CX = m_rowCx.data();
-		float* __restrict CY = m_rowCy.data();
-		for (int c = 0; c < cols; c++)
-		{
-			const float fy = fyRow[c], fz = fzRow[c];
-			const float down = n0 + n1 * fy + n2 * fz;
-			// mh < 0: rays going down (down < 0) meet the ground at t > 0; rays
-			// parallel to it or rising get t <= 0 (or -inf), which the next
-			// loop skips. No branch, so the loop vectorizes.
-			const float t = mh / down;
-			T[c] = t;
-			CX[c] = bx + t * (X0 + X1 * fy + X2 * fz);
-			CY[c] = by + t * (Y0 + Y1 * fy + Y2 * fz);
-		}
+		const uint16_t* __restrict raw = img.data + size_t(r) * img.stride;
 		int prev = 0;  // previous pixel of the row: 0 none, 1 seen floor, 2 empty on seen floor
 		const bool statsRow = (r / step) % m_params.stats_row_step == 0;
-		for (int c = 0; c < cols; c += step)
-		{
-			const uint16_t v = img.at(r, c);
-			// Outside the statistics rows only empty rays matter: a return
-			// within the range is never one.
-			if (!statsRow && v != 0 && double(v) * units <= maxRange) continue;
+		// One pixel whose ray may meet the ground within the range, at depth
+		// tf in cell (cxf, cyf).
+		const auto judgeRay = [&](int c, float tf, float cxf, float cyf) {
 			const int before = prev;
 			prev = 0;
-			const double t = T[c];  // depth at which the ray meets the ground
+			const double t = tf;
 			// (A range along the ray is >= the depth t: t beyond the range is too.)
-			if (!(t > 0) || t > maxRange) continue;
+			if (!(t > 0) || t > maxRange) return;
 			double expected = t;  // in the image's own measure
 			if (!img.is_depth)
 			{
 				const double fy = fyRow[c], fz = fzRow[c];
 				expected = t * std::sqrt(1.0 + fy * fy + fz * fz);
 			}
-			if (expected < m_params.min_range || expected > maxRange) continue;
-			if (!(CX[c] >= 0.f && CY[c] >= 0.f)) continue;
-			if (v == 0 && fxBaseline > 0 && missing::outsideSecondImager(c, t, fxBaseline)) continue;
-			const int cx = int(CX[c]), cy = int(CY[c]);
-			if (cx >= g.nx || cy >= g.ny) continue;
+			if (expected < m_params.min_range || expected > maxRange) return;
+			if (!(cxf >= 0.f && cyf >= 0.f)) return;
+			const uint16_t v = raw[c];
+			if (v == 0 && fxBaseline > 0 && missing::outsideSecondImager(c, t, fxBaseline)) return;
+			const int cx = int(cxf), cy = int(cyf);
+			if (cx >= g.nx || cy >= g.ny) return;
 			const double got = double(v) * units;
 			const bool empty = v == 0 || (got > maxRange && got > expected + m_params.beyond_margin);
 			if (statsRow) stats.rays++;
@@ -178,10 +218,74 @@ void MissingFloorDetector::compute(
 					if (empty) pairsBothEmpty++;
 				}
 			}
-			if (!empty) continue;
+			if (!empty) return;
 			if (m_empty[cell] == 0) m_touched.push_back(cell);
 			if (m_empty[cell] < 65535) m_empty[cell]++;
+		};
+		// The candidates: rays that may meet the ground within the range and,
+		// outside the statistics rows (where only empty rays matter), that
+		// are empty: no return, or one beyond the range.
+		const auto candidate = [&](int c) {
+			const bool meets = n0 + n1 * fyRow[c] + n2 * fzRow[c] < thrDown;
+			return uint8_t(meets & (statsRow | (uint16_t(raw[c] - 1) >= rawInRange)));
+		};
+		const auto judgeOne = [&](int c) {
+			float t, cxf, cyf;
+			rays.meet(fyRow[c], fzRow[c], t, cxf, cyf);
+			judgeRay(c, t, cxf, cyf);
+		};
+		if (step != 1)
+		{
+			for (int c = 0; c < cols; c += step)
+				if (candidate(c))
+					judgeOne(c);
+				else
+					prev = 0;
+			continue;
 		}
+		uint8_t* __restrict isCandidate = m_rowCandidate.data();
+		int candidates = 0;
+		for (int c = 0; c < cols; c++)
+		{
+			isCandidate[c] = candidate(c);
+			candidates += isCandidate[c];
+		}
+		// Where the rays meet the ground: in a vector loop for the whole row
+		// where candidates are many (a statistics row, a row of dropouts),
+		// else one candidate at a time.
+		const bool wholeRow = 8 * candidates > cols;
+		if (wholeRow) meetGroundRow(rays, fyRow, fzRow, cols, m_rowT.data(), m_rowCx.data(), m_rowCy.data());
+		const float* T = m_rowT.data();
+		const float* CX = m_rowCx.data();
+		const float* CY = m_rowCy.data();
+		const auto judge = [&](int c) {
+			if (wholeRow)
+				judgeRay(c, T[c], CX[c], CY[c]);
+			else
+				judgeOne(c);
+		};
+		// They are few: skip eight pixels without one at a time.
+		int c = 0;
+		for (; c + 8 <= cols; c += 8)
+		{
+			uint64_t eight;
+			std::memcpy(&eight, isCandidate + c, 8);
+			if (!eight)
+			{
+				prev = 0;
+				continue;
+			}
+			for (int j = c; j < c + 8; j++)
+				if (isCandidate[j])
+					judge(j);
+				else
+					prev = 0;
+		}
+		for (; c < cols; c++)
+			if (isCandidate[c])
+				judge(c);
+			else
+				prev = 0;
 	}
 	if (pairsAfterEmpty) m_p11 = double(pairsBothEmpty) / double(pairsAfterEmpty);
 

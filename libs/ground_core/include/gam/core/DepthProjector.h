@@ -145,6 +145,11 @@ class DepthProjector
 	std::vector<int32_t> m_rowCell;
 	std::vector<float> m_rowZ;
 	std::vector<uint8_t> m_rowKeep;  // 0: a flying pixel
+	// The flying-pixel filter's candidates of one row: columns, their two
+	// lines (14 x width floats) and the answers of the tests.
+	std::vector<int32_t> m_flyCols;
+	std::vector<float> m_flyLines;
+	std::vector<uint8_t> m_flyAlong, m_flyAgainstNothing;
 	bool m_allowAvx2 = true;
 };
 

@@ -271,6 +271,7 @@ class ElevationGrid
 	std::vector<FrameCell> m_frame;
 	std::vector<uint32_t> m_frameTouched;
 	std::vector<float> m_filterMean, m_filterLimit;
+	std::vector<uint8_t> m_flagged;  // 1: the cell's samples are re-accumulated within mean +- limit
 	std::vector<float> m_idwWeights;
 	std::vector<uint32_t> m_idwNeighbours;
 };

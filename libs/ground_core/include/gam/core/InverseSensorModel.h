@@ -414,6 +414,7 @@ class InverseSensorModel
 	std::vector<TailCandidate> m_tailCandidates;
 	std::vector<float> m_tailLo, m_tailHi;
 	std::vector<uint32_t> m_tailCount;
+	std::vector<uint8_t> m_tailCell;  ///< 1 for the tail candidates' cells (during countTailSamples)
 	// Local-plane support raster: bit k set = plane k applies in that block.
 	std::vector<uint8_t> m_support;
 	int m_blockCells = 4, m_bnx = 0, m_bny = 0;

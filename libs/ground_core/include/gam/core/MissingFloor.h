@@ -177,8 +177,10 @@ class MissingFloorDetector
 	std::vector<uint32_t> m_binRays, m_binEmpty;
 	double m_p11 = -1;
 	double m_baseline = 0;
-	// One image row: depth at which each ray meets the ground and the
-	// (fractional) grid cell it meets there; computed in a vectorizable loop.
+	// One image row: 1 for each pixel that needs judging, and the depth at
+	// which each ray meets the ground and the (fractional) grid cell it meets
+	// there (see compute()).
+	std::vector<uint8_t> m_rowCandidate;
 	std::vector<float> m_rowT, m_rowCx, m_rowCy;
 };
 
