@@ -75,6 +75,11 @@ std::string RunSummary::text() const
 			s << std::setw(12) << fmtMs(percentile(m.ms2D, 0.5)) << std::setw(12) << fmtMs(percentile(m.ms2D, 0.95));
 		s << "\n";
 	}
+	for (const auto& m : maps)
+		if (!m.setMs.empty())
+			s << m.label << ": " << m.setMs.size()
+			  << " sets of depth frames of several cameras at one pose (threads > 1), per set: median "
+			  << fmtMs(percentile(m.setMs, 0.5)) << " ms, p95 " << fmtMs(percentile(m.setMs, 0.95)) << " ms\n";
 	for (const auto& n : notes) s << n << "\n";
 	return s.str();
 }

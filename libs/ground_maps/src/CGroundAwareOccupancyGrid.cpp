@@ -123,6 +123,16 @@ const bool kTraitsRegistered = [] {
 					: (s.alarms_raised ? ": the alarm was raised and cleared again" : ""));
 			out += (out.empty() ? "" : "\n") + std::string(b);
 		}
+		if (g.groundOptions().threads > 1)
+		{
+			const auto& ps = g.parallelStats();
+			out += (out.empty() ? "" : "\n") + mrpt::format(
+												   "threads=%d: %llu depth frames fused from a pipeline that ran "
+												   "alongside another camera's, %llu run again in their turn (the "
+												   "grid had moved under them)",
+												   g.groundOptions().threads, (unsigned long long)ps.ran_ahead,
+												   (unsigned long long)ps.run_again);
+		}
 		const gam::PipelineParams& pp = g.groundOptions().pipeline;
 		for (const auto& [label, cam] : g.cameras())
 		{
