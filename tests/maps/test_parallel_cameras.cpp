@@ -5,6 +5,7 @@
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CSensoryFrame.h>
 
 #include <stdexcept>
 #include <string>
@@ -130,13 +131,17 @@ TEST(ParallelCameras, TwoCamerasThreads2IsByteIdenticalToOneByOne)
 	for (const bool stateful : {false, true})
 	{
 		CGroundAwareOccupancyGrid oneByOne = makeGrid(1, stateful), batch1 = makeGrid(1, stateful),
-								  batch2 = makeGrid(2, stateful), batch3 = makeGrid(3, stateful);
+								  batch2 = makeGrid(2, stateful), batch3 = makeGrid(3, stateful),
+								  fromSf = makeGrid(2, stateful);
 		for (const PoseFrames& p : poses)
 		{
 			for (const auto& o : p.frames) oneByOne.insertObservation(*o, p.robot);
 			EXPECT_TRUE(batch1.insertObservations(pointers(p), p.robot));
 			EXPECT_TRUE(batch2.insertObservations(pointers(p), p.robot));
 			EXPECT_TRUE(batch3.insertObservations(pointers(p), p.robot));
+			mrpt::obs::CSensoryFrame sf;
+			for (const auto& o : p.frames) sf.insert(o);
+			EXPECT_TRUE(fromSf.insertObservations(sf, p.robot));
 		}
 		const std::string what = stateful ? "measured mount + obstacle decay" : "defaults";
 		// The walk makes a map (not an empty comparison), and it grew the grid.
@@ -145,6 +150,7 @@ TEST(ParallelCameras, TwoCamerasThreads2IsByteIdenticalToOneByOne)
 		expectSameGrid(oneByOne, batch1, what + ", threads=1");
 		expectSameGrid(oneByOne, batch2, what + ", threads=2");
 		expectSameGrid(oneByOne, batch3, what + ", threads=3");
+		expectSameGrid(oneByOne, fromSf, what + ", a CSensoryFrame, threads=2");
 		// Both ways were taken: frames fused from a pipeline that ran ahead,
 		// and frames run again because the first camera's evidence grew the
 		// grid onto a frame-grid corner that differs in its last bits.

@@ -8,6 +8,7 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <algorithm>
@@ -614,6 +615,14 @@ bool CGroundAwareOccupancyGrid::insertObservations(
 	}
 	m_batch.clear();
 	return inserted;
+}
+
+bool CGroundAwareOccupancyGrid::insertObservations(
+	const mrpt::obs::CSensoryFrame& sf, const mrpt::poses::CPose3D& robotPose)
+{
+	m_sfObservations.clear();
+	for (const auto& o : sf) m_sfObservations.push_back(o.get());
+	return insertObservations(m_sfObservations, robotPose);
 }
 
 void CGroundAwareOccupancyGrid::syncMissingLayer() const { syncLayer(m_missingLayer); }

@@ -18,7 +18,8 @@
 namespace mrpt::obs
 {
 class CObservation2DRangeScan;
-}
+class CSensoryFrame;
+}  // namespace mrpt::obs
 
 namespace mrpt::maps
 {
@@ -169,6 +170,9 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	bool insertObservations(
 		const std::vector<const mrpt::obs::CObservation*>& observations, const mrpt::poses::CPose3D& robotPose,
 		const std::function<void(size_t)>& afterEach = {});
+	/** The same for the observations of a sensory frame, in its order (what
+	 * CSensoryFrame::insertObservationsInto() does one by one). */
+	bool insertObservations(const mrpt::obs::CSensoryFrame& sf, const mrpt::poses::CPose3D& robotPose);
 
 	/** insertObservations() with threads > 1 since the grid was created: depth
 	 * frames whose pipeline ran ahead, concurrently, and whose result was
@@ -317,6 +321,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	gam::maps::WorkerPool m_pool;
 	std::vector<TBatchSlot> m_batch;  ///< during insertObservations() (capacity kept)
 	TParallelStats m_parallelStats;
+	std::vector<const mrpt::obs::CObservation*> m_sfObservations;  ///< scratch (capacity kept)
 	TFrameTimes m_times;
 	std::map<std::string, gam::MountMonitor> m_mounts;  // not serialized: state of a run
 	std::string m_lastSensorLabel;
