@@ -7,6 +7,7 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CSensoryFrame.h>
 
+#include <iostream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -154,6 +155,9 @@ TEST(ParallelCameras, TwoCamerasThreads2IsByteIdenticalToOneByOne)
 		// Both ways were taken: frames fused from a pipeline that ran ahead,
 		// and frames run again because the first camera's evidence grew the
 		// grid onto a frame-grid corner that differs in its last bits.
+		std::cout << "[parallel] " << what << ": threads=2 " << batch2.parallelStats().ran_ahead
+				  << " frames fused from a pipeline that ran ahead, " << batch2.parallelStats().run_again
+				  << " run again\n";
 		EXPECT_EQ(batch1.parallelStats().ran_ahead + batch1.parallelStats().run_again, 0u);
 		EXPECT_GE(batch2.parallelStats().ran_ahead, 10u) << what;
 		EXPECT_GE(batch2.parallelStats().run_again, 1u) << what;
