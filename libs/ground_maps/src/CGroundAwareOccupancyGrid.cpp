@@ -127,12 +127,13 @@ const bool kTraitsRegistered = [] {
 		if (g.groundOptions().threads > 1)
 		{
 			const auto& ps = g.parallelStats();
-			out += (out.empty() ? "" : "\n") + mrpt::format(
-												   "threads=%d: %llu depth frames fused from a pipeline that ran "
-												   "alongside another camera's, %llu run again in their turn (the "
-												   "grid had moved under them)",
-												   g.groundOptions().threads, (unsigned long long)ps.ran_ahead,
-												   (unsigned long long)ps.run_again);
+			out += (out.empty() ? "" : "\n") +
+				   mrpt::format(
+					   "threads=%d: %llu depth frames fused from a pipeline that ran alongside another camera's (%llu "
+					   "of them "
+					   "on a worker thread), %llu run again in their turn (the grid had moved under them)",
+					   g.groundOptions().threads, (unsigned long long)ps.ran_ahead, (unsigned long long)ps.on_worker,
+					   (unsigned long long)ps.run_again);
 		}
 		const gam::PipelineParams& pp = g.groundOptions().pipeline;
 		for (const auto& [label, cam] : g.cameras())
@@ -478,6 +479,7 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 	if (ahead)
 	{
 		m_parallelStats.ran_ahead++;
+		m_parallelStats.on_worker += ahead->onWorker;
 		if (ahead->error) std::rethrow_exception(ahead->error);
 		const gam::StageTimes& st = pipeline.result().ms;
 		aheadMs = st.projection + st.outliers + st.ground + st.ism + st.missing;
@@ -549,7 +551,9 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 
 void CGroundAwareOccupancyGrid::runBatchSlot(void* grid, size_t i)
 {
-	TBatchSlot& slot = static_cast<CGroundAwareOccupancyGrid*>(grid)->m_batch[i];
+	auto& self = *static_cast<CGroundAwareOccupancyGrid*>(grid);
+	TBatchSlot& slot = self.m_batch[i];
+	slot.onWorker = std::this_thread::get_id() != self.m_batchCaller;
 	const TPreparedFrame& p = slot.prepared;
 	try
 	{
@@ -593,6 +597,7 @@ bool CGroundAwareOccupancyGrid::insertObservations(
 				m_batch.pop_back();
 			}
 		}
+		m_batchCaller = std::this_thread::get_id();
 		if (m_batch.size() > 1)
 			m_pool.run(m_batch.size(), &CGroundAwareOccupancyGrid::runBatchSlot, this);
 		else

@@ -180,6 +180,9 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	struct TParallelStats
 	{
 		uint64_t ran_ahead = 0, run_again = 0;
+		/** Of the frames that ran ahead: run by a worker thread (the others by
+		 * the calling thread, which takes what no worker has taken yet). */
+		uint64_t on_worker = 0;
 	};
 	const TParallelStats& parallelStats() const { return m_parallelStats; }
 
@@ -291,7 +294,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		const mrpt::obs::CObservation* obs = nullptr;
 		TPreparedFrame prepared;
 		std::exception_ptr error;  ///< what process() threw
-		bool ran = false, taken = false;
+		bool ran = false, taken = false, onWorker = false;
 	};
 	static void runBatchSlot(void* grid, size_t i);
 	bool insert2D(
@@ -321,6 +324,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	gam::maps::WorkerPool m_pool;
 	std::vector<TBatchSlot> m_batch;  ///< during insertObservations() (capacity kept)
 	TParallelStats m_parallelStats;
+	std::thread::id m_batchCaller;
 	std::vector<const mrpt::obs::CObservation*> m_sfObservations;  ///< scratch (capacity kept)
 	TFrameTimes m_times;
 	std::map<std::string, gam::MountMonitor> m_mounts;  // not serialized: state of a run
