@@ -47,12 +47,14 @@ namespace
 {
 std::atomic<size_t> g_allocs{0};
 thread_local bool t_counting = false;
+// Counts every thread's allocations (the worker threads of `threads` > 1).
+std::atomic<bool> g_countAllThreads{false};
 thread_local bool t_inTrace = false;
 bool g_trace = false;
 
 void noteAllocation(std::size_t n)
 {
-	if (!t_counting) return;
+	if (!t_counting && !g_countAllThreads.load(std::memory_order_relaxed)) return;
 	g_allocs.fetch_add(1, std::memory_order_relaxed);
 	if (g_trace && !t_inTrace)
 	{
@@ -95,6 +97,18 @@ class AllocCounter
    public:
 	AllocCounter() : m_start(g_allocs.load()) { t_counting = true; }
 	~AllocCounter() { t_counting = false; }
+	size_t count() const { return g_allocs.load() - m_start; }
+
+   private:
+	size_t m_start;
+};
+
+/** Counts the allocations of every thread during its lifetime. */
+class AllThreadsAllocCounter
+{
+   public:
+	AllThreadsAllocCounter() : m_start(g_allocs.load()) { g_countAllThreads = true; }
+	~AllThreadsAllocCounter() { g_countAllThreads = false; }
 	size_t count() const { return g_allocs.load() - m_start; }
 
    private:
@@ -276,6 +290,48 @@ TEST(NoAlloc, GroundAwareGridRealAndSyntheticFramesSteadyState)
 	std::cout << "[alloc] real+synthetic: " << total << " allocations in " << kMeasured * frames.size()
 			  << " frames (worst frame " << worst << ")\n";
 	EXPECT_EQ(worst, 0u) << "heap allocations per frame after warm-up; run with GAM_ALLOC_TRACE=1 to see where";
+}
+
+// Issue #28: two cameras at one pose through insertObservations(), with
+// threads = 1 and 2 (the worker's allocations count too): nothing either way
+// once the pool's thread and each camera's pipeline exist.
+TEST(NoAlloc, TwoCamerasInsertObservationsThreads1And2SteadyState)
+{
+	auto s = testscene::floorWithHole(-1, 6, -3, 3, 2.0, 2.4, -0.3, 0.3, 0.5);
+	s.push_back({1.5, 0.6, 0.0, 1.7, 0.8, 0.10});
+	auto forward = testscene::renderDepth(s, CPose3D(0.10, 0, 0.80, 0, DEG2RAD(25.0), 0));
+	auto down = testscene::renderDepth(s, CPose3D(0.05, 0, 0.60, 0, DEG2RAD(60.0), 0));
+	down->sensorLabel = "KINECT_DOWN";
+	const std::vector<const mrpt::obs::CObservation*> set{forward.get(), down.get()};
+	for (const int threads : {1, 2})
+	{
+		CGroundAwareOccupancyGrid grid;
+		auto o = grid.groundOptions();
+		o.threads = threads;
+		grid.setGroundOptions(o);
+		auto poseAt = [](int k) { return CPose3D(0.01 * k, 0.003 * k, 0, DEG2RAD(0.2 * k), 0, 0); };
+		int step = 0;
+		for (int i = 0; i < kWarmUp; i++) grid.insertObservations(set, poseAt(step++));
+		size_t worst = 0, total = 0;
+		for (int i = 0; i < kMeasured; i++)
+		{
+			const CPose3D pose = poseAt(step++);
+			size_t n;
+			{
+				AllThreadsAllocCounter count;
+				grid.insertObservations(set, pose);
+				n = count.count();
+			}
+			EXPECT_TRUE(grid.lastFrame().detection.ok()) << grid.lastFrame().detection.describe();
+			total += n;
+			worst = std::max(worst, n);
+		}
+		if (threads > 1) EXPECT_GT(grid.parallelStats().ran_ahead, 0u);
+		std::cout << "[alloc] two cameras, threads=" << threads << ": " << total << " allocations in " << kMeasured
+				  << " frame pairs (worst pair " << worst << ")\n";
+		EXPECT_EQ(worst, 0u) << "threads=" << threads
+							 << ": heap allocations per frame pair after warm-up; GAM_ALLOC_TRACE=1 shows where";
+	}
 }
 
 // The pure core pipeline (no MRPT): gam::GroundAwarePipeline, the object the

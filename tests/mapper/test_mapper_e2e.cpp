@@ -113,18 +113,20 @@ double rayBox(const mrpt::math::TPoint3D& o, const mrpt::math::TPoint3D& d, cons
 	return t0;
 }
 
-mrpt::obs::CObservation3DRangeScan::Ptr makeFrame(double robotX)
+mrpt::obs::CObservation3DRangeScan::Ptr makeFrame(
+	double robotX, const std::string& label = "DEPTH",
+	const mrpt::poses::CPose3D& sensorPose = mrpt::poses::CPose3D(0.1, 0, 0.6, 0, mrpt::DEG2RAD(30.0), 0))
 {
 	const int W = 160, H = 120;
 	const double fx = 120, fy = 120, cx = 79.5, cy = 59.5;
 	auto o = mrpt::obs::CObservation3DRangeScan::Create();
-	o->sensorLabel = "DEPTH";
+	o->sensorLabel = label;
 	o->timestamp = mrpt::Clock::fromDouble(1000.0 + robotX);
 	o->hasRangeImage = true;
 	o->range_is_depth = true;
 	o->rangeUnits = 0.001f;
 	o->maxRange = 5.0f;
-	o->sensorPose = mrpt::poses::CPose3D(0.1, 0, 0.6, 0, mrpt::DEG2RAD(30.0), 0);
+	o->sensorPose = sensorPose;
 	o->cameraParams.ncols = W;
 	o->cameraParams.nrows = H;
 	o->cameraParams.setIntrinsicParamsFromValues(fx, fy, cx, cy);
@@ -185,6 +187,36 @@ void writeSfFormat(const std::string& path)
 		mrpt::obs::CSensoryFrame sf;
 		sf.insert(makeFrame(x));
 		ar << acts << sf;
+	}
+}
+
+// Two cameras (issue #28): the forward one and one looking down at the near
+// field, both at each pose with one timestamp, as observations and as
+// sensory frames.
+const mrpt::poses::CPose3D kDownCamera(0.05, 0, 0.5, 0, mrpt::DEG2RAD(60.0), 0);
+
+void writeTwoCameraRawlogs(const std::string& obsPath, const std::string& sfPath)
+{
+	mrpt::io::CFileGZOutputStream fo(obsPath), fsf(sfPath);
+	auto ao = mrpt::serialization::archiveFrom(fo);
+	auto as = mrpt::serialization::archiveFrom(fsf);
+	double prev = 0;
+	for (double x : kPosesX)
+	{
+		auto odo = mrpt::obs::CObservationOdometry::Create();
+		odo->sensorLabel = "ODOMETRY";
+		odo->odometry = mrpt::poses::CPose2D(x, 0, 0);
+		ao << *odo << *makeFrame(x) << *makeFrame(x, "DEPTH_DOWN", kDownCamera);
+		mrpt::obs::CActionCollection acts;
+		mrpt::obs::CActionRobotMovement2D mov;
+		mrpt::obs::CActionRobotMovement2D::TMotionModelOptions mm;
+		mov.computeFromOdometry(mrpt::poses::CPose2D(x - prev, 0, 0), mm);
+		acts.insert(mov);
+		prev = x;
+		mrpt::obs::CSensoryFrame sf;
+		sf.insert(makeFrame(x));
+		sf.insert(makeFrame(x, "DEPTH_DOWN", kDownCamera));
+		as << acts << sf;
 	}
 }
 
@@ -829,4 +861,47 @@ TEST_F(MapperE2E, InitialMapStartsEveryGridThatCanFromAStockMap)
 	expectError(
 		runMapper("--rawlog '" + obsRawlog + "' --out '" + out + "' --initial-map '" + kTmp + "/bad.yaml'"), 2,
 		{"--initial-map", "bad.yaml", "not a ROS map_server map"}, out);
+}
+
+// Issue #28: with threads = 2 the mapper inserts the two cameras' frames of
+// each pose as one set, and every output is byte-identical to threads = 1:
+// the maps, the planes, the snapshots (a set ends at a snapshot) and the
+// local window.
+TEST(MapperThreads, TwoCamerasThreads2GivesTheSameOutputsAsThreads1)
+{
+	fs::create_directories(kTmp);
+	const std::string obs = kTmp + "/two_obs.rawlog", sf = kTmp + "/two_sf.rawlog";
+	writeTwoCameraRawlogs(obs, sf);
+	const std::string t2 = withDefaultConfigEdited("threads2", "\nthreads=1 ", "\nthreads=2 ");
+	for (const std::string& rawlog : {obs, sf})
+		for (const std::string& extra :
+			 {std::string(""), std::string(" --snapshot-every 3"), std::string(" --local-map --local-size-cells 80")})
+		{
+			SCOPED_TRACE(rawlog + extra);
+			const std::string a = freshDir("thr1"), b = freshDir("thr2");
+			const auto r1 = runMapper("--rawlog '" + rawlog + "' --out '" + a + "' -q" + extra);
+			const auto r2 = runMapper("--rawlog '" + rawlog + "' --out '" + b + "' -q -c '" + t2 + "'" + extra);
+			ASSERT_EQ(r1.rc, 0) << r1.err;
+			ASSERT_EQ(r2.rc, 0) << r2.err;
+			EXPECT_NE(r1.out.find("frames: 8 (8 3D scans"), std::string::npos) << r1.out;
+			EXPECT_EQ(r1.out.find("sets of depth frames"), std::string::npos) << r1.out;
+			// 4 poses: 4 sets, unless the snapshot after frame 3 splits the
+			// second pose's pair (frames 2 | 3) and so leaves 3.
+			EXPECT_NE(
+				r2.out.find(
+					std::string("ground_aware: ") + (extra.find("snapshot") != std::string::npos ? "3" : "4") +
+					" sets of depth frames"),
+				std::string::npos)
+				<< r2.out;
+			size_t compared = 0;
+			for (const auto& de : fs::recursive_directory_iterator(a))
+			{
+				if (!de.is_regular_file()) continue;
+				const std::string rel = fs::relative(de.path(), a).string();
+				if (rel == "timing.csv" || rel == "config_used.ini") continue;
+				EXPECT_EQ(slurp(de.path().string()), slurp(b + "/" + rel)) << rel;
+				compared++;
+			}
+			EXPECT_GE(compared, 10u);
+		}
 }

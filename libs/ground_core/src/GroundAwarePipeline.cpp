@@ -80,6 +80,14 @@ void GroundAwarePipeline::resetResult()
 	m_result.ms = StageTimes{};
 }
 
+Eigen::Vector2d GroundAwarePipeline::gridOrigin(const Eigen::Vector3d& robot, const GridLattice& lattice) const
+{
+	const double res = lattice.resolution;
+	return {
+		lattice.x0 + std::round((robot.x() - 0.5 * m_params.m_x * res - lattice.x0) / res) * res,
+		lattice.y0 + std::round((robot.y() - 0.5 * m_params.m_y * res - lattice.y0) / res) * res};
+}
+
 void GroundAwarePipeline::placeGrid(const Eigen::Vector3d& robot, const GridLattice& lattice)
 {
 	// m_x x m_y cells centred on the robot, on the caller's cell lattice.
@@ -88,8 +96,9 @@ void GroundAwarePipeline::placeGrid(const Eigen::Vector3d& robot, const GridLatt
 	g.resolution = res;
 	g.nx = m_params.m_x;
 	g.ny = m_params.m_y;
-	g.x_min = lattice.x0 + std::round((robot.x() - 0.5 * m_params.m_x * res - lattice.x0) / res) * res;
-	g.y_min = lattice.y0 + std::round((robot.y() - 0.5 * m_params.m_y * res - lattice.y0) / res) * res;
+	const Eigen::Vector2d origin = gridOrigin(robot, lattice);
+	g.x_min = origin.x();
+	g.y_min = origin.y();
 	const GridGeometry& cur = m_grid.geometry();
 	if (cur.nx != g.nx || cur.ny != g.ny || cur.resolution != g.resolution)
 		m_grid.resize(g);

@@ -94,6 +94,10 @@ void MissingFloorDetector::compute(
 	{
 		m_empty.assign(N, 0);
 		m_mark.assign(N, 0);
+		// Each list holds a cell at most once: reserved to that bound, so no
+		// later frame allocates (grown on demand, a pipeline that had seen only
+		// a few frames -- one per camera -- still grew them now and then).
+		for (std::vector<uint32_t>* v : {&m_touched, &m_cells, &m_blocking, &m_queue, &m_region}) v->reserve(N);
 	}
 	if (!frame.has_image || classes.size() != N || !(maxRange > m_params.min_range)) return;
 	const RangeImageView& img = frame.image;

@@ -6,6 +6,7 @@
 #include <gam/maps/MapRegistry.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/core/bits_math.h>
+#include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
@@ -74,6 +75,11 @@ std::string RunSummary::text() const
 			s << std::setw(12) << fmtMs(percentile(m.ms2D, 0.5)) << std::setw(12) << fmtMs(percentile(m.ms2D, 0.95));
 		s << "\n";
 	}
+	for (const auto& m : maps)
+		if (!m.setMs.empty())
+			s << m.label << ": " << m.setMs.size()
+			  << " sets of depth frames of several cameras at one pose (threads > 1), per set: median "
+			  << fmtMs(percentile(m.setMs, 0.5)) << " ms, p95 " << fmtMs(percentile(m.setMs, 0.95)) << " ms\n";
 	for (const auto& n : notes) s << n << "\n";
 	return s.str();
 }
@@ -139,6 +145,10 @@ Mapper::Mapper(const MapperOptions& opts) : m_opts(opts)
 		if (m_maps.maps[i]->GetRuntimeClass()->className != m_specs[i].className)
 			throw ConfigError("internal: CMultiMetricMap map order differs from the .ini order");
 	if (!m_opts.initialMap.empty()) loadInitialMap();
+	for (const auto& m : m_maps.maps)
+		if (const auto* g = dynamic_cast<const CGroundAwareOccupancyGrid*>(m.get());
+			g && g->groundOptions().threads > 1)
+			m_frameSets = true;
 }
 
 void Mapper::loadInitialMap()
@@ -266,21 +276,85 @@ void Mapper::begin()
 	}
 }
 
+void Mapper::applySensorPose(Frame& fr) const
+{
+	if (m_sensorPoses.empty()) return;
+	const auto sp = m_sensorPoses.find(fr.obs->sensorLabel);
+	if (sp != m_sensorPoses.end()) fr.obs->setSensorPose(sp->second);
+}
+
+void Mapper::countFrame(const Frame& fr, bool is3D)
+{
+	RunSummary& s = m_run->s;
+	s.frames++;
+	(is3D ? s.frames3D : s.frames2D)++;
+	if (!fr.hasOdometry) s.framesWithoutOdometry++;
+}
+
+void Mapper::recordFrame(size_t i, const Frame& fr, bool is3D, double ms)
+{
+	RunState& r = *m_run;
+	RunSummary& s = r.s;
+	auto& map = *m_maps.maps[i];
+	s.maps[i].totalMs.push_back(ms);
+	(is3D ? s.maps[i].ms3D : s.maps[i].ms2D).push_back(ms);
+	const std::string& L = m_specs[i].label;
+	r.timing << fr.index << "," << L << ",total," << ms << "\n";
+	const gam::maps::MapTraits* t = r.traits[i];
+	if (t && t->stageTimes)
+		t->stageTimes(map, is3D, [&](const char* stage, double stageMs) {
+			r.timing << fr.index << "," << L << "," << stage << "," << stageMs << "\n";
+		});
+	gam::maps::GroundPlaneRecord gp;
+	if (int(i) == r.planesFrom && is3D && t->lastGroundPlane(map, gp))
+	{
+		r.planes << fr.index << ",";
+		if (gp.found)
+			r.planes << gp.a << "," << gp.b << "," << gp.c << "," << gp.d;
+		else
+			r.planes << ",,,";
+		r.planes << "," << gp.nodes << "," << gp.status << ",";
+		if (gp.mount_measured)
+			r.planes << gp.mount_z << "," << gp.mount_pitch_deg << "," << gp.mount_roll_deg << ","
+					 << (gp.mount_alarm ? 1 : 0);
+		else
+			r.planes << ",,,";
+		// Several cameras: each frame's plane is its own camera's.
+		r.planes << "," << fr.obs->sensorLabel << "\n";
+	}
+}
+
+void Mapper::afterFrames(const Frame& last)
+{
+	RunState& r = *m_run;
+	RunSummary& s = r.s;
+	m_lastPose = last.robotPose;
+	if (m_opts.snapshotEvery && s.frames % m_opts.snapshotEvery == 0)
+	{
+		char name[32];
+		std::snprintf(name, sizeof(name), "%06zu", s.frames);
+		try
+		{
+			writeSnapshot(r.snapDir + "/" + name);
+		}
+		catch (const std::exception& e)
+		{
+			throw RunError("writing snapshot " + std::string(name) + ": " + conciseError(e.what()));
+		}
+		r.snapIndex << name << "," << s.frames << "," << last.index << "," << last.entry << "," << last.robotPose.x()
+					<< "," << last.robotPose.y() << "," << mrpt::RAD2DEG(last.robotPose.yaw()) << "\n";
+		s.snapshots++;
+	}
+}
+
 void Mapper::insert(Frame& fr)
 {
 	using clk = std::chrono::steady_clock;
 	if (!m_run) throw std::logic_error("Mapper::insert() before begin()");
 	RunState& r = *m_run;
-	RunSummary& s = r.s;
-	if (!m_sensorPoses.empty())
-	{
-		const auto sp = m_sensorPoses.find(fr.obs->sensorLabel);
-		if (sp != m_sensorPoses.end()) fr.obs->setSensorPose(sp->second);
-	}
+	applySensorPose(fr);
 	const bool is3D = IS_CLASS(*fr.obs, mrpt::obs::CObservation3DRangeScan);
-	s.frames++;
-	(is3D ? s.frames3D : s.frames2D)++;
-	if (!fr.hasOdometry) s.framesWithoutOdometry++;
+	countFrame(fr, is3D);
 
 	for (size_t i = 0; i < m_specs.size(); i++)
 	{
@@ -296,57 +370,104 @@ void Mapper::insert(Frame& fr)
 				"frame " + std::to_string(fr.index) + " (rawlog entry " + std::to_string(fr.entry) + "), map " +
 				m_specs[i].label + ": " + conciseError(e.what()));
 		}
-		const double ms = std::chrono::duration<double, std::milli>(clk::now() - t0).count();
-		s.maps[i].totalMs.push_back(ms);
-		(is3D ? s.maps[i].ms3D : s.maps[i].ms2D).push_back(ms);
-		const std::string& L = m_specs[i].label;
-		r.timing << fr.index << "," << L << ",total," << ms << "\n";
-		const gam::maps::MapTraits* t = r.traits[i];
-		if (t && t->stageTimes)
-			t->stageTimes(map, is3D, [&](const char* stage, double stageMs) {
-				r.timing << fr.index << "," << L << "," << stage << "," << stageMs << "\n";
-			});
-		gam::maps::GroundPlaneRecord gp;
-		if (int(i) == r.planesFrom && is3D && t->lastGroundPlane(map, gp))
-		{
-			r.planes << fr.index << ",";
-			if (gp.found)
-				r.planes << gp.a << "," << gp.b << "," << gp.c << "," << gp.d;
-			else
-				r.planes << ",,,";
-			r.planes << "," << gp.nodes << "," << gp.status << ",";
-			if (gp.mount_measured)
-				r.planes << gp.mount_z << "," << gp.mount_pitch_deg << "," << gp.mount_roll_deg << ","
-						 << (gp.mount_alarm ? 1 : 0);
-			else
-				r.planes << ",,,";
-			// Several cameras: each frame's plane is its own camera's.
-			r.planes << "," << fr.obs->sensorLabel << "\n";
-		}
+		recordFrame(i, fr, is3D, std::chrono::duration<double, std::milli>(clk::now() - t0).count());
 	}
 
-	m_lastPose = fr.robotPose;
 	if (m_opts.localMap)
 		for (size_t i = 0; i < m_specs.size(); i++)
 			if (r.traits[i] && r.traits[i]->keepWindow)
 				r.traits[i]->keepWindow(*m_maps.maps[i], fr.robotPose.x(), fr.robotPose.y(), m_opts.localCells);
+	afterFrames(fr);
+}
 
-	if (m_opts.snapshotEvery && s.frames % m_opts.snapshotEvery == 0)
+void Mapper::insertSet(std::vector<Frame>& set)
+{
+	using clk = std::chrono::steady_clock;
+	if (!m_run) throw std::logic_error("Mapper::insertSet() before begin()");
+	if (set.size() == 1) return insert(set[0]);
+	RunState& r = *m_run;
+	RunSummary& s = r.s;
+	for (Frame& fr : set)
 	{
-		char name[32];
-		std::snprintf(name, sizeof(name), "%06zu", s.frames);
+		applySensorPose(fr);
+		countFrame(fr, true);
+	}
+	std::vector<const mrpt::obs::CObservation*> obs;
+	for (const Frame& fr : set) obs.push_back(fr.obs.get());
+	const mrpt::poses::CPose3D& pose = set[0].robotPose;
+	for (size_t i = 0; i < m_specs.size(); i++)
+	{
+		auto& map = *m_maps.maps[i];
+		const gam::maps::MapTraits* t = r.traits[i];
+		const auto keepWindow = [&] {
+			if (m_opts.localMap && t && t->keepWindow) t->keepWindow(map, pose.x(), pose.y(), m_opts.localCells);
+		};
+		size_t k = 0;  // the frame being inserted (for messages)
 		try
 		{
-			writeSnapshot(r.snapDir + "/" + name);
+			if (auto* g = dynamic_cast<CGroundAwareOccupancyGrid*>(&map))
+			{
+				// The frames' pipelines run concurrently (threads); each frame
+				// is then fused, recorded and windowed in order, as one by one.
+				const auto t0 = clk::now();
+				g->insertObservations(obs, pose, [&](size_t j) {
+					k = j + 1;
+					recordFrame(i, set[j], true, g->lastFrameTimes().total);
+					keepWindow();
+				});
+				const double ms = std::chrono::duration<double, std::milli>(clk::now() - t0).count();
+				s.maps[i].setMs.push_back(ms);
+				r.timing << set[0].index << "," << m_specs[i].label << ",frame_set," << ms << "\n";
+			}
+			else
+			{
+				double setMs = 0;
+				for (k = 0; k < set.size(); k++)
+				{
+					const auto t0 = clk::now();
+					map.insertObservation(*set[k].obs, pose);
+					const double ms = std::chrono::duration<double, std::milli>(clk::now() - t0).count();
+					setMs += ms;
+					recordFrame(i, set[k], true, ms);
+					keepWindow();
+				}
+				s.maps[i].setMs.push_back(setMs);
+				r.timing << set[0].index << "," << m_specs[i].label << ",frame_set," << setMs << "\n";
+			}
+		}
+		catch (const RunError&)
+		{
+			throw;
 		}
 		catch (const std::exception& e)
 		{
-			throw RunError("writing snapshot " + std::string(name) + ": " + conciseError(e.what()));
+			const Frame& fr = set[std::min(k, set.size() - 1)];
+			throw RunError(
+				"frame " + std::to_string(fr.index) + " (rawlog entry " + std::to_string(fr.entry) + "), map " +
+				m_specs[i].label + ": " + conciseError(e.what()));
 		}
-		r.snapIndex << name << "," << s.frames << "," << fr.index << "," << fr.entry << "," << fr.robotPose.x() << ","
-					<< fr.robotPose.y() << "," << mrpt::RAD2DEG(fr.robotPose.yaw()) << "\n";
-		s.snapshots++;
 	}
+	afterFrames(set.back());
+}
+
+bool Mapper::joinsSet(const std::vector<Frame>& set, const Frame& fr) const
+{
+	if (set.empty() || !IS_CLASS(*fr.obs, mrpt::obs::CObservation3DRangeScan)) return false;
+	const Frame& first = set[0];
+	if (!IS_CLASS(*first.obs, mrpt::obs::CObservation3DRangeScan)) return false;
+	// Taken at one robot pose and one time, by another camera.
+	const auto& a = first.robotPose;
+	const auto& b = fr.robotPose;
+	if (!(a.x() == b.x() && a.y() == b.y() && a.z() == b.z() && a.yaw() == b.yaw() && a.pitch() == b.pitch() &&
+		  a.roll() == b.roll()) ||
+		first.hasOdometry != fr.hasOdometry || first.obs->timestamp != fr.obs->timestamp)
+		return false;
+	for (const Frame& f : set)
+		if (f.obs->sensorLabel == fr.obs->sensorLabel) return false;
+	// A snapshot is of the maps after a given number of frames: a set ends there.
+	const size_t n = m_opts.snapshotEvery;
+	if (n && (m_run->s.frames + set.size()) % n == 0) return false;
+	return true;
 }
 
 std::vector<std::string> Mapper::publishMapsNow()
@@ -463,22 +584,43 @@ RunSummary Mapper::run()
 	};
 	const auto tStart = m_run->tStart;
 	auto lastProgress = clk::now();
+	// threads > 1: the depth frames of several cameras at one pose go in as a set.
+	std::vector<Frame> set;
 	Frame fr;
+	bool haveNext = false, atEnd = false;
+	const auto readNext = [&] {
+		try
+		{
+			haveNext = reader->next(fr) && !(m_opts.maxFrames && fr.index >= m_opts.maxFrames);
+		}
+		catch (const std::exception& e)
+		{
+			throw RunError(e.what());
+		}
+	};
 	try
 	{
-		while (true)
+		while (!atEnd)
 		{
 			if (m_opts.stopRequested && *m_opts.stopRequested) throw RunError("interrupted");
-			try
+			if (!haveNext) readNext();
+			if (!haveNext) break;
+			set.clear();
+			set.push_back(fr);
+			haveNext = false;
+			while (m_frameSets)
 			{
-				if (!reader->next(fr)) break;
+				readNext();
+				if (!haveNext)
+				{
+					atEnd = true;
+					break;
+				}
+				if (!joinsSet(set, fr)) break;
+				set.push_back(fr);
+				haveNext = false;
 			}
-			catch (const std::exception& e)
-			{
-				throw RunError(e.what());
-			}
-			if (m_opts.maxFrames && fr.index >= m_opts.maxFrames) break;
-			insert(fr);
+			insertSet(set);
 
 			if (m_opts.progress)
 			{

@@ -8,9 +8,11 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -122,6 +124,17 @@ const bool kTraitsRegistered = [] {
 					: (s.alarms_raised ? ": the alarm was raised and cleared again" : ""));
 			out += (out.empty() ? "" : "\n") + std::string(b);
 		}
+		if (g.groundOptions().threads > 1)
+		{
+			const auto& ps = g.parallelStats();
+			out += (out.empty() ? "" : "\n") +
+				   mrpt::format(
+					   "threads=%d: %llu depth frames fused from a pipeline that ran alongside another camera's (%llu "
+					   "of them "
+					   "on a worker thread), %llu run again in their turn (the grid had moved under them)",
+					   g.groundOptions().threads, (unsigned long long)ps.ran_ahead, (unsigned long long)ps.on_worker,
+					   (unsigned long long)ps.run_again);
+		}
 		const gam::PipelineParams& pp = g.groundOptions().pipeline;
 		for (const auto& [label, cam] : g.cameras())
 		{
@@ -209,8 +222,12 @@ void CGroundAwareOccupancyGrid::TGroundAwareOptions::validate() const
 void CGroundAwareOccupancyGrid::setGroundOptions(const TGroundAwareOptions& o)
 {
 	o.validate();
-	m_pipeline.setParams(o.pipeline);
+	m_idlePipeline.setParams(o.pipeline);
+	for (auto& [label, pipeline] : m_pipelines) pipeline.setParams(o.pipeline);
 	for (auto& [label, monitor] : m_mounts) monitor.setParams(o.mount);
+	// A pipeline that ran ahead ran with the old parameters.
+	for (TBatchSlot& slot : m_batch) slot.ran = false;
+	m_pool.resize(o.threads);
 	m_options = o;
 }
 
@@ -375,39 +392,103 @@ bool CGroundAwareOccupancyGrid::insert2D(
 	return changed;
 }
 
+gam::GroundAwarePipeline& CGroundAwareOccupancyGrid::pipelineFor(const std::string& label)
+{
+	auto it = m_pipelines.find(label);
+	if (it == m_pipelines.end()) it = m_pipelines.emplace(label, gam::GroundAwarePipeline(m_options.pipeline)).first;
+	return it->second;
+}
+
+const gam::GroundAwarePipeline& CGroundAwareOccupancyGrid::lastPipeline() const
+{
+	if (!m_lastHasPipeline) return m_idlePipeline;
+	const auto it = m_pipelines.find(m_lastSensorLabel);
+	return it == m_pipelines.end() ? m_idlePipeline : it->second;
+}
+
+void CGroundAwareOccupancyGrid::prepareFrame(
+	const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose, TPreparedFrame& p)
+{
+	// Adapt the observation once (samples and sensor pose) onto a frame grid
+	// aligned with this grid's cells.
+	p.frame = gam::SensorFrame{};
+	gam::maps::toSensorFrame(obs, robotPose, p.frame);
+	p.pipeline = &pipelineFor(obs.sensorLabel);
+	obs.getSensorPose(p.declared);
+	p.used = p.declared;
+	const auto mon = m_mounts.find(obs.sensorLabel);
+	if (mon != m_mounts.end() && m_options.mount.enabled && m_options.mount.use_measured &&
+		mon->second.status().has_estimate)
+	{
+		// x, y and yaw are not observable from the floor: they stay declared.
+		const gam::MountStatus& ms = mon->second.status();
+		p.used = mrpt::poses::CPose3D(
+			p.declared.x(), p.declared.y(), ms.estimate.height, p.declared.yaw(), ms.estimate.pitch, ms.estimate.roll);
+		gam::maps::placeSensor(robotPose + p.used, p.frame);
+	}
+	p.robot = Eigen::Vector3d(robotPose.x(), robotPose.y(), robotPose.z());
+	p.lattice = gam::GridLattice{getXMin(), getYMin(), getResolution()};
+	p.origin = p.pipeline->gridOrigin(p.robot, p.lattice);
+}
+
+bool CGroundAwareOccupancyGrid::TPreparedFrame::sameInputs(const TPreparedFrame& o) const
+{
+	// Exact comparisons: a result is taken only when its inputs are the same bits.
+	const auto pose6 = [](const mrpt::poses::CPose3D& q) {
+		return std::array<double, 6>{q.x(), q.y(), q.z(), q.yaw(), q.pitch(), q.roll()};
+	};
+	return pipeline == o.pipeline && robot == o.robot && origin == o.origin &&
+		   lattice.resolution == o.lattice.resolution && pose6(used) == pose6(o.used);
+}
+
 bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose)
 {
 	using clk = std::chrono::steady_clock;
 	const auto t0 = clk::now();
-	m_pipeline.resetResult();
+	// Until this frame's pipeline is known, lastFrame() is "no frame".
+	m_lastHasPipeline = false;
 	m_times = TFrameTimes{};
 	m_depthFrames++;
 
-	// Adapt the observation once (samples and sensor pose), run the method on
-	// a frame grid aligned with this grid's cells, fuse its evidence.
-	gam::SensorFrame frame;
-	gam::maps::toSensorFrame(obs, robotPose, frame);
+	TPreparedFrame prep;
+	prepareFrame(obs, robotPose, prep);
 	// The mount check of this sensor (one per label: several cameras).
 	if (m_lastSensorLabel != obs.sensorLabel) m_lastSensorLabel = obs.sensorLabel;
+	m_lastHasPipeline = true;
 	auto mon = m_mounts.find(obs.sensorLabel);
 	if (mon == m_mounts.end()) mon = m_mounts.emplace(obs.sensorLabel, gam::MountMonitor(m_options.mount)).first;
-	mrpt::poses::CPose3D declared;
-	obs.getSensorPose(declared);
-	mrpt::poses::CPose3D used = declared;
-	const gam::MountStatus& ms = mon->second.status();
-	if (m_options.mount.enabled && m_options.mount.use_measured && ms.has_estimate)
+	const mrpt::poses::CPose3D& declared = prep.declared;
+	const mrpt::poses::CPose3D& used = prep.used;
+	gam::GroundAwarePipeline& pipeline = *prep.pipeline;
+	const gam::SensorFrame& frame = prep.frame;
+
+	// insertObservations(): this frame's pipeline may have run ahead, on what
+	// it would run on now (or not: then it runs again, here).
+	double aheadMs = 0;
+	TBatchSlot* ahead = nullptr;
+	for (TBatchSlot& slot : m_batch)
+		if (slot.obs == &obs && !slot.taken)
+		{
+			slot.taken = true;
+			if (slot.ran && slot.prepared.sameInputs(prep))
+				ahead = &slot;
+			else
+				m_parallelStats.run_again++;
+			break;
+		}
+	if (ahead)
 	{
-		// x, y and yaw are not observable from the floor: they stay declared.
-		used = mrpt::poses::CPose3D(
-			declared.x(), declared.y(), ms.estimate.height, declared.yaw(), ms.estimate.pitch, ms.estimate.roll);
-		gam::maps::placeSensor(robotPose + used, frame);
+		m_parallelStats.ran_ahead++;
+		m_parallelStats.on_worker += ahead->onWorker;
+		if (ahead->error) std::rethrow_exception(ahead->error);
+		const gam::StageTimes& st = pipeline.result().ms;
+		aheadMs = st.projection + st.outliers + st.ground + st.ism + st.missing;
 	}
-	m_pipeline.process(
-		frame, Eigen::Vector3d(robotPose.x(), robotPose.y(), robotPose.z()),
-		gam::GridLattice{getXMin(), getYMin(), getResolution()});
+	else
+		pipeline.process(frame, prep.robot, prep.lattice);
 	{
 		TCameraInfo& cam = m_cameras[obs.sensorLabel];
-		const gam::FrameResult& res = m_pipeline.result();
+		const gam::FrameResult& res = pipeline.result();
 		cam.model = res.camera;
 		cam.trust_range = res.trust_range;
 		cam.height = frame.sensor_position.z() - robotPose.z();
@@ -419,7 +500,7 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 		// The floor in the sensor's own frame says where the sensor is: compare
 		// with the declared mount (whatever pose placed the points).
 		std::optional<gam::SensorMount> measured;
-		const gam::GroundDetection& det = m_pipeline.result().detection;
+		const gam::GroundDetection& det = pipeline.result().detection;
 		if (det.ok() && !det.planes.empty())
 		{
 			const mrpt::poses::CPose3D w = robotPose + used;
@@ -434,17 +515,17 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 		mon->second.update({declared.z(), declared.pitch(), declared.roll()}, measured);
 	}
 	const auto t1 = clk::now();
-	applyEvidence();
+	applyEvidence(pipeline);
 	if (m_options.obstacle_decay_s > 0 && obs.timestamp != INVALID_TIMESTAMP)
 	{
 		// Positive obstacles of this frame are fresh; cells that were judged a
 		// hole, a drop or missing floor never decay.
 		const double t = mrpt::Clock::toDouble(obs.timestamp);
-		const auto& g = m_pipeline.frameGrid().geometry();
-		const auto& cls = m_pipeline.ism().classes();
-		const auto& ev = m_pipeline.ism().evidence();
-		const auto& missing = m_pipeline.missingFloor();
-		for (uint32_t c : m_pipeline.ism().evidenceCells())
+		const auto& g = pipeline.frameGrid().geometry();
+		const auto& cls = pipeline.ism().classes();
+		const auto& ev = pipeline.ism().evidence();
+		const auto& missing = pipeline.missingFloor();
+		for (uint32_t c : pipeline.ism().evidenceCells())
 		{
 			const int wx = x2idx(g.cx(int(c % uint32_t(g.nx)))), wy = y2idx(g.cy(int(c / uint32_t(g.nx))));
 			if (ev[c] <= 0.5f) continue;
@@ -461,10 +542,92 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 	const auto t2 = clk::now();
 
 	m_times.update = std::chrono::duration<double, std::milli>(t2 - t1).count();
-	m_times.total = std::chrono::duration<double, std::milli>(t2 - t0).count();
+	// (A pipeline that ran ahead, concurrently: its own time counts.)
+	m_times.total = std::chrono::duration<double, std::milli>(t2 - t0).count() + aheadMs;
 	// A frame is "inserted" even if it found no ground: it was processed, and
 	// lastFrame() says why nothing changed.
 	return true;
+}
+
+void CGroundAwareOccupancyGrid::runBatchSlot(void* grid, size_t i)
+{
+	auto& self = *static_cast<CGroundAwareOccupancyGrid*>(grid);
+	TBatchSlot& slot = self.m_batch[i];
+	slot.onWorker = std::this_thread::get_id() != self.m_batchCaller;
+	const TPreparedFrame& p = slot.prepared;
+	try
+	{
+		p.pipeline->process(p.frame, p.robot, p.lattice);
+	}
+	catch (...)
+	{
+		// Thrown again where insertObservation() would have thrown it.
+		slot.error = std::current_exception();
+	}
+	slot.ran = true;
+}
+
+bool CGroundAwareOccupancyGrid::insertObservations(
+	const std::vector<const mrpt::obs::CObservation*>& observations, const mrpt::poses::CPose3D& robotPose,
+	const std::function<void(size_t)>& afterEach)
+{
+	using namespace mrpt::obs;
+	m_batch.clear();
+	if (m_options.threads > 1 && genericMapParams.enableObservationInsertion)
+	{
+		// The first depth frame of each label runs ahead on the grid as it is
+		// now; a second frame of a label needs the first's mount update and
+		// the same pipeline, so it runs in order.
+		for (const CObservation* o : observations)
+		{
+			if (!o || !(IS_CLASS(*o, CObservation3DRangeScan) || IS_CLASS(*o, CObservationPointCloud))) continue;
+			if (std::any_of(m_batch.begin(), m_batch.end(), [&](const TBatchSlot& b) {
+					return b.obs->sensorLabel == o->sensorLabel;
+				}))
+				continue;
+			TBatchSlot& slot = m_batch.emplace_back();
+			slot.obs = o;
+			try
+			{
+				prepareFrame(*o, robotPose, slot.prepared);
+			}
+			catch (const std::exception&)
+			{
+				// A malformed frame: insertObservation() throws it in its turn.
+				m_batch.pop_back();
+			}
+		}
+		m_batchCaller = std::this_thread::get_id();
+		if (m_batch.size() > 1)
+			m_pool.run(m_batch.size(), &CGroundAwareOccupancyGrid::runBatchSlot, this);
+		else
+			m_batch.clear();  // nothing to overlap
+	}
+	bool inserted = false;
+	try
+	{
+		for (size_t i = 0; i < observations.size(); i++)
+		{
+			if (!observations[i]) continue;
+			inserted |= insertObservation(*observations[i], robotPose);
+			if (afterEach) afterEach(i);
+		}
+	}
+	catch (...)
+	{
+		m_batch.clear();
+		throw;
+	}
+	m_batch.clear();
+	return inserted;
+}
+
+bool CGroundAwareOccupancyGrid::insertObservations(
+	const mrpt::obs::CSensoryFrame& sf, const mrpt::poses::CPose3D& robotPose)
+{
+	m_sfObservations.clear();
+	for (const auto& o : sf) m_sfObservations.push_back(o.get());
+	return insertObservations(m_sfObservations, robotPose);
 }
 
 void CGroundAwareOccupancyGrid::syncMissingLayer() const { syncLayer(m_missingLayer); }
@@ -546,15 +709,15 @@ bool CGroundAwareOccupancyGrid::isMissingFloor(float x, float y) const
 	return L.getCell(unsigned(cx), unsigned(cy)) < 0.5f;
 }
 
-void CGroundAwareOccupancyGrid::applyEvidence()
+void CGroundAwareOccupancyGrid::applyEvidence(const gam::GroundAwarePipeline& pipeline)
 {
-	const gam::InverseSensorModel& ism = m_pipeline.ism();
-	const gam::MissingFloorDetector& missing = m_pipeline.missingFloor();
+	const gam::InverseSensorModel& ism = pipeline.ism();
+	const gam::MissingFloorDetector& missing = pipeline.missingFloor();
 	const auto& cells = ism.evidenceCells();
 	const auto& missingCells = missing.cells();
 	if (cells.empty() && missingCells.empty()) return;
 	const auto& ev = ism.evidence();
-	const auto& g = m_pipeline.frameGrid().geometry();
+	const auto& g = pipeline.frameGrid().geometry();
 
 	// Grow the grid to hold the evidence (MRPT keeps the cell alignment).
 	int x0 = g.nx, x1 = -1, y0 = g.ny, y1 = -1;

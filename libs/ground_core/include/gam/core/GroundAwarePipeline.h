@@ -142,6 +142,12 @@ class GroundAwarePipeline
 	 * robot position, a bad lattice or a malformed frame. */
 	const FrameResult& process(const SensorFrame& frame, const Eigen::Vector3d& robot, const GridLattice& lattice);
 
+	/** The corner (x_min, y_min) of the frame grid that process() lays for a
+	 * robot at `robot` on `lattice`. Besides the lattice's resolution, the
+	 * only way the lattice enters a frame's result: two lattices that give
+	 * the same corner give the same result, bit for bit. */
+	Eigen::Vector2d gridOrigin(const Eigen::Vector3d& robot, const GridLattice& lattice) const;
+
 	/** Forgets the last frame (result().valid = false); buffers are kept. */
 	void resetResult();
 

@@ -98,6 +98,11 @@ struct MapTiming
 	std::string label, className;
 	std::vector<double> totalMs;     ///< per frame (all frames)
 	std::vector<double> ms3D, ms2D;  ///< the same, split by frame kind
+	/** Per set of frames inserted together (the depth frames of several
+	 * cameras at one pose, threads > 1): the wall time of the set [ms]. A
+	 * frame of a set has as its time in totalMs its own share: its fusion,
+	 * and its pipeline's stages, which may have run alongside another's. */
+	std::vector<double> setMs;
 	/** Median / 95th percentile over the 3D frames (over all frames if there are none). */
 	double median() const;
 	double p95() const;
@@ -134,6 +139,11 @@ class Mapper
 	/** Inserts one frame into every map: [sensor_poses], timing.csv,
 	 * ground_planes.csv, the local window, --snapshot-every. Throws RunError. */
 	void insert(Frame& fr);
+	/** Inserts depth frames of different cameras taken at one robot pose
+	 * (run() forms them when a ground-aware grid has threads > 1): into a
+	 * ground-aware grid at once (insertObservations()), into the other maps
+	 * one by one; every frame is recorded as insert() records it. */
+	void insertSet(std::vector<Frame>& set);
 	/** The outputs of every map as they are now, moved into DIR file by file
 	 * (each write is a rename, so DIR never holds a part-written file); the
 	 * run goes on. Returns the file names. Throws RunError. */
@@ -156,6 +166,16 @@ class Mapper
 
    private:
 	void writeMaps(const std::string& dir, std::vector<std::string>& files);
+	void applySensorPose(Frame& fr) const;
+	void countFrame(const Frame& fr, bool is3D);
+	/** timing.csv, per-map timing and ground_planes.csv rows of map i for a frame just inserted. */
+	void recordFrame(size_t i, const Frame& fr, bool is3D, double ms);
+	/** After a frame or a set: --snapshot-every. */
+	void afterFrames(const Frame& last);
+	/** Whether `fr` joins `set` (same pose and time, another camera's depth frame). */
+	bool joinsSet(const std::vector<Frame>& set, const Frame& fr) const;
+	/** A ground-aware grid has threads > 1: run() forms sets of frames. */
+	bool m_frameSets = false;
 	/** The map_server maps of every 2D grid into `dir` (created). Throws std::runtime_error. */
 	void writeSnapshot(const std::string& dir) const;
 	MapperOptions m_opts;

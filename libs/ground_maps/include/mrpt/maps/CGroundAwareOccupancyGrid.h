@@ -1,20 +1,25 @@
 // Ground-aware mapping for MRPT
 #pragma once
 
+#include <exception>
+#include <functional>
 #include <map>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 
 #include "gam/core/GroundAwarePipeline.h"
 #include "gam/core/SensorMount.h"
+#include "gam/maps/WorkerPool.h"
 
 namespace mrpt::obs
 {
 class CObservation2DRangeScan;
-}
+class CSensoryFrame;
+}  // namespace mrpt::obs
 
 namespace mrpt::maps
 {
@@ -94,6 +99,12 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		/** The online check of the declared sensor mount (height, pitch, roll)
 		 * against every frame's floor, and the option to map with the measured one. */
 		gam::MountCheckParams mount;
+		/** Threads for the depth frames of several cameras taken at one robot
+		 * pose (insertObservations()): their pipelines run concurrently, and
+		 * their evidence is fused in the order given, so the map is the same
+		 * byte for byte whatever this is. 1 (the default) = one frame after
+		 * the other in the calling thread; at most 64. */
+		int threads = 1;
 
 		/** Every `_groundOpts` key: the pipeline's, then the 2D-scan ones. */
 		template <class Self, class Visit>
@@ -116,6 +127,12 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 					"positive obstacles not re-observed for this long return to unknown [s]; 0 = never"},
 				o.obstacle_decay_s);
 			gam::MountCheckParams::forEachParam(o.mount, visit);
+			visit(
+				gam::ParamInfo{
+					"threads", 1, 64,
+					"threads for the depth frames of several cameras at one robot pose (insertObservations); the map "
+					"is the same for any value"},
+				o.threads);
 		}
 		/** Loads and validates (throws std::invalid_argument naming the key). */
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
@@ -135,8 +152,42 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		double update = 0;  ///< log-odds fusion into this grid [ms]
 		double total = 0;   ///< the whole insertion [ms]
 	};
+	/** Inserts observations taken at one robot pose (the depth frames of
+	 * several cameras, e.g. one CSensoryFrame) and returns whether any was
+	 * inserted. The result is, byte for byte, that of insertObservation() on
+	 * each in the order given, for any `threads`: with threads > 1 the
+	 * pipelines of the first depth frame of each sensor label run
+	 * concurrently on the grid as it is at the call; then every observation
+	 * is inserted in order, each depth frame taking its pipeline's result if
+	 * what that pipeline ran on (the frame grid's corner on this grid's
+	 * lattice, the sensor pose) is still what it would run on now, and
+	 * running it again otherwise (the grid grew or was recentred in between
+	 * by more than a whole number of cells, or the mount estimate moved).
+	 * `afterEach(i)`, if given, is called after observation i was inserted
+	 * (lastFrame() is then that frame's). Null pointers are skipped. An
+	 * exception leaves the grid as insertObservation() would have: the
+	 * observations before the failing one are inserted. */
+	bool insertObservations(
+		const std::vector<const mrpt::obs::CObservation*>& observations, const mrpt::poses::CPose3D& robotPose,
+		const std::function<void(size_t)>& afterEach = {});
+	/** The same for the observations of a sensory frame, in its order (what
+	 * CSensoryFrame::insertObservationsInto() does one by one). */
+	bool insertObservations(const mrpt::obs::CSensoryFrame& sf, const mrpt::poses::CPose3D& robotPose);
+
+	/** insertObservations() with threads > 1 since the grid was created: depth
+	 * frames whose pipeline ran ahead, concurrently, and whose result was
+	 * fused; and those whose inputs had changed by their turn, run again. */
+	struct TParallelStats
+	{
+		uint64_t ran_ahead = 0, run_again = 0;
+		/** Of the frames that ran ahead: run by a worker thread (the others by
+		 * the calling thread, which takes what no worker has taken yet). */
+		uint64_t on_worker = 0;
+	};
+	const TParallelStats& parallelStats() const { return m_parallelStats; }
+
 	/** What happened to the last 3D frame (for apps, viewers and logs). */
-	const gam::FrameResult& lastFrame() const { return m_pipeline.result(); }
+	const gam::FrameResult& lastFrame() const { return lastPipeline().result(); }
 	const TFrameTimes& lastFrameTimes() const { return m_times; }
 	/** The mount check per sensor label (gam::MountMonitor): the declared and
 	 * the measured height, pitch and roll, the counters and the alarm. */
@@ -158,9 +209,9 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	const std::string& lastSensorLabel() const { return m_lastSensorLabel; }
 
 	/** The 2.5D map of the last 3D frame. */
-	const gam::ElevationGrid& lastFrameElevation() const { return m_pipeline.frameGrid(); }
+	const gam::ElevationGrid& lastFrameElevation() const { return lastPipeline().frameGrid(); }
 	/** The ISM evidence and voxel classes of the last 3D frame (frame grid). */
-	const gam::InverseSensorModel& lastFrameIsm() const { return m_pipeline.ism(); }
+	const gam::InverseSensorModel& lastFrameIsm() const { return lastPipeline().ism(); }
 
 	/** Missing floor (issue #13): where the ground plane predicted a floor
 	 * return within range and the camera returned nothing. A grid of the same
@@ -220,9 +271,35 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 
    private:
 	bool insert3D(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose);
+	/** What a depth frame's pipeline runs on, given the state of the grid now. */
+	struct TPreparedFrame
+	{
+		gam::GroundAwarePipeline* pipeline = nullptr;
+		gam::SensorFrame frame;
+		Eigen::Vector3d robot = Eigen::Vector3d::Zero();
+		gam::GridLattice lattice;
+		mrpt::poses::CPose3D declared, used;               ///< the sensor pose declared, and the one placing the points
+		Eigen::Vector2d origin = Eigen::Vector2d::Zero();  ///< the frame grid's corner (gridOrigin())
+		/** Same inputs, so the same result bit for bit (the observation being the same). */
+		bool sameInputs(const TPreparedFrame& o) const;
+	};
+	/** Fills `p` (creates the label's pipeline on first use; the mount monitor is only read). */
+	void prepareFrame(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& robotPose, TPreparedFrame& p);
+	gam::GroundAwarePipeline& pipelineFor(const std::string& label);
+	/** The pipeline of the last depth frame (an idle one before any). */
+	const gam::GroundAwarePipeline& lastPipeline() const;
+	/** A depth frame of insertObservations() whose pipeline ran ahead. */
+	struct TBatchSlot
+	{
+		const mrpt::obs::CObservation* obs = nullptr;
+		TPreparedFrame prepared;
+		std::exception_ptr error;  ///< what process() threw
+		bool ran = false, taken = false, onWorker = false;
+	};
+	static void runBatchSlot(void* grid, size_t i);
 	bool insert2D(
 		const mrpt::obs::CObservation2DRangeScan& scan, const std::optional<const mrpt::poses::CPose3D>& robotPose);
-	void applyEvidence();
+	void applyEvidence(const gam::GroundAwarePipeline& pipeline);
 	/** Gives the missing-floor layer this grid's geometry (cells kept). */
 	void syncMissingLayer() const;
 	/** Gives a layer this grid's geometry, keeping the cells both cover. */
@@ -236,8 +313,19 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	void decayObstacles(double t);
 
 	TGroundAwareOptions m_options;
-	// The method and its per-frame workspace (not serialized).
-	gam::GroundAwarePipeline m_pipeline;
+	// The method and its per-frame workspace, one per sensor label, so that
+	// the frames of several cameras can run at once (not serialized). A
+	// pipeline carries nothing from one frame to the next but buffers, so
+	// this gives the maps one shared pipeline gave. (std::map: its nodes stay
+	// put, so pointers to them hold while labels are added.)
+	std::map<std::string, gam::GroundAwarePipeline> m_pipelines;
+	gam::GroundAwarePipeline m_idlePipeline;  ///< lastFrame() before any depth frame
+	bool m_lastHasPipeline = false;
+	gam::maps::WorkerPool m_pool;
+	std::vector<TBatchSlot> m_batch;  ///< during insertObservations() (capacity kept)
+	TParallelStats m_parallelStats;
+	std::thread::id m_batchCaller;
+	std::vector<const mrpt::obs::CObservation*> m_sfObservations;  ///< scratch (capacity kept)
 	TFrameTimes m_times;
 	std::map<std::string, gam::MountMonitor> m_mounts;  // not serialized: state of a run
 	std::string m_lastSensorLabel;
