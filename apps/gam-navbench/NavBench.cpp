@@ -182,6 +182,9 @@ RunResult runOne(const gam::sim::GeneratedScene& g, const std::string& map, cons
 	res.plans = r.plans;
 	res.failedPlans = r.failedPlans;
 	res.turningSeconds = r.turningSeconds;
+	res.partialPlans = r.partialPlans;
+	res.backups = r.backups;
+	res.planFollows = r.planFollows;
 	res.endState = r.endState;
 	for (size_t i = 1; i < r.trajectory.size(); i++)
 		res.pathLength +=
@@ -247,7 +250,8 @@ std::string markdownTable(const std::vector<RunResult>& runs, const std::vector<
 std::string csvHeader()
 {
 	return "seed,map,outcome,arrived,fall,collision,stuck,timeout,time_s,path_m,final_distance_m,gt_path_m,"
-		   "line_hazard,hit_object,hit_name,frames,plans,failed_plans,turning_s,end_state,wall_s\n";
+		   "line_hazard,hit_object,hit_name,frames,plans,failed_plans,turning_s,partial_plans,backups,plan_follows,end_"
+		   "state,wall_s\n";
 }
 
 std::string csvRow(const RunResult& r)
@@ -257,7 +261,8 @@ std::string csvRow(const RunResult& r)
 	  << r.stuck << "," << r.timedOut << "," << std::fixed << std::setprecision(2) << r.seconds << "," << r.pathLength
 	  << "," << r.finalDistance << "," << r.gtPathLength << "," << r.lineHazard << "," << r.hitObject << ","
 	  << r.hitName << "," << r.frames << "," << r.plans << "," << r.failedPlans << "," << r.turningSeconds << ","
-	  << r.endState << "," << r.wallSeconds << "\n";
+	  << r.partialPlans << "," << r.backups << "," << r.planFollows << "," << r.endState << "," << r.wallSeconds
+	  << "\n";
 	return s.str();
 }
 
@@ -275,7 +280,12 @@ void drawTrajectories(
 	const std::vector<std::string>& maps, const std::string& file, int scale)
 {
 	if (scenes.empty()) return;
-	const int gap = 8, head = 36, label = 30;
+	// MRPT's "9x15" bitmap font: 9 px a character; lines 16 px apart.
+	const int charW = 9, lineH = 16;
+	const int gap = 8, head = 2 * lineH + 8, label = 2 * lineH;
+	const std::string key =
+		"ground truth: black obstacle, orange drop; grey: a person's crossing; x: where a run ended short";
+	auto textWidth = [&](const std::string& t) { return charW * int(t.size()); };
 	std::vector<gam::sim::GroundTruthGrid> gts;
 	int W = 0, H = head;
 	for (const auto* g : scenes)
@@ -284,35 +294,46 @@ void drawTrajectories(
 		W = std::max(W, gts.back().spec.nx() * scale);
 		H += label + gts.back().spec.ny() * scale + gap;
 	}
-	W = std::max(W + 2 * gap, 760);
+	// The picture is as wide as its widest line of text: the key, the legend
+	// and each scene's lines (its outcomes name every map).
+	int legendW = 0;
+	for (const auto& m : maps) legendW += 20 + textWidth(m) + 2 * charW;
+	auto title = [&](const gam::sim::GeneratedScene& g) {
+		std::ostringstream t;
+		t << "seed " << g.seed << ": " << gam::sim::hazardKindName(g.lineHazard)
+		  << " on the straight line (o start, square goal)";
+		return t.str();
+	};
+	auto outcomes = [&](const gam::sim::GeneratedScene& g) {
+		std::string u = "outcomes:";
+		for (const auto& m : maps)
+			for (const auto& r : runs)
+				if (r.seed == g.seed && r.map == m) u += " " + r.map + " " + r.outcome;
+		return u;
+	};
+	int textW = std::max(textWidth(key), legendW);
+	for (const auto* g : scenes) textW = std::max({textW, textWidth(title(*g)), textWidth(outcomes(*g))});
+	W = std::max(W, textW) + 2 * gap;
 	mrpt::img::CImage im(W, H, mrpt::img::CH_RGB);
+	im.selectTextFont("9x15");
 	im.filledRectangle(0, 0, W - 1, H - 1, mrpt::img::TColor(255, 255, 255));
 	// legend
 	int lx = gap;
 	for (size_t k = 0; k < maps.size(); k++)
 	{
-		im.filledRectangle(lx, 8, lx + 14, 11, mapColour(k));
+		im.filledRectangle(lx, 9, lx + 14, 12, mapColour(k));
 		im.textOut(lx + 20, 4, maps[k], mapColour(k));
-		lx += 36 + 8 * int(maps[k].size());
+		lx += 20 + textWidth(maps[k]) + 2 * charW;
 	}
-	im.textOut(
-		gap, 18, "ground truth: black obstacle, orange drop; grey: a person's crossing; x: where a run ended short",
-		mrpt::img::TColor(0, 0, 0));
+	im.textOut(gap, 4 + lineH, key, mrpt::img::TColor(0, 0, 0));
 	int oy = head;
 	for (size_t si = 0; si < scenes.size(); si++)
 	{
 		const auto& g = *scenes[si];
 		const auto& gt = gts[si];
 		const int nx = gt.spec.nx(), ny = gt.spec.ny();
-		std::ostringstream t, u;
-		t << "seed " << g.seed << ": " << gam::sim::hazardKindName(g.lineHazard)
-		  << " on the straight line (o start, square goal)";
-		u << "outcomes:";
-		for (size_t k = 0; k < maps.size(); k++)
-			for (const auto& r : runs)
-				if (r.seed == g.seed && r.map == maps[k]) u << " " << r.map << " " << r.outcome;
-		im.textOut(gap, oy, t.str(), mrpt::img::TColor(0, 0, 0));
-		im.textOut(gap, oy + 13, u.str(), mrpt::img::TColor(0, 0, 0));
+		im.textOut(gap, oy, title(g), mrpt::img::TColor(0, 0, 0));
+		im.textOut(gap, oy + lineH, outcomes(g), mrpt::img::TColor(0, 0, 0));
 		oy += label;
 		auto px = [&](double x) { return gap + int(std::lround((x - gt.spec.min_x) / gt.spec.resolution * scale)); };
 		auto py = [&](double y) {

@@ -79,10 +79,10 @@ struct BenchOptions
 	/** Time limit = timeBase + timePerMetre * the ground-truth path length
 	 * (6 s/m = three times the walker's 0.5 m/s). */
 	double timeBase = 30, timePerMetre = 6;
-	/** PlannerSimple2D's robot radius [m], the nav example's. (0.40 m, the
-	 * turning square's 0.354 m plus a cell, was tried: the planner then often
-	 * found the walker's own cell inside the grown noise of the map and no path.) */
-	double planRadius = 0.30;
+	/** PlannerSimple2D's robot radius [m]; 0: from the navigator's footprint
+	 * (gam::nav::plannerRadiusForFootprint of the half side grown by its
+	 * margin: 0.375 m on 5 cm cells, ceil() = 8 cells). */
+	double planRadius = 0;
 	/** If set: DIR/seed_<N>_<map>.png, the map at the end with the trajectory
 	 * (red), start (green) and goal (blue), and DIR/seed_<N>_<map>_trajectory.csv
 	 * (t, x, y, phi of the true pose every simulation step). */
@@ -106,6 +106,7 @@ struct RunResult
 	size_t frames = 0;
 	int plans = 0, failedPlans = 0;
 	double turningSeconds = 0;
+	int partialPlans = 0, backups = 0, planFollows = 0;  ///< see gam::nav::ClosedLoopResult
 	double wallSeconds = 0;
 	std::vector<mrpt::math::TPose2D> trajectory;
 };

@@ -60,9 +60,24 @@ struct MapOptions
  * Both grids keep their default options (paper Table I, band 0.2-1.5 m). */
 void buildMaps(const gam::sim::SceneFile& sf, const MapOptions& opts, NavMaps& out);
 
+/** The smallest PlannerSimple2D::robotRadius whose obstacle growth keeps a
+ * square footprint of half side `halfSide` off every obstacle cell in any
+ * heading. PlannerSimple2D grows each obstacle cell by n = ceil(radius /
+ * resolution) cells in a square (8-neighbour dilation), so a path cell's
+ * centre is at least n + 1/2 cells from the near edge of any obstacle cell
+ * along an axis; the footprint turned by 45 deg reaches halfSide * sqrt(2)
+ * (its circumcircle). n = ceil(halfSide * sqrt(2) / resolution - 1/2); the
+ * radius returned is (n - 1/2) * resolution, well inside ceil()'s step. E.g.
+ * 0.25 m, 5 cm cells: n = 7 (0.325 m); 0.30 m: n = 8 (0.375 m). */
+double plannerRadiusForFootprint(double halfSide, double resolution);
+
 struct PlanOptions
 {
-	float robotRadius = 0.30f;  ///< PlannerSimple2D::robotRadius [m]
+	/** PlannerSimple2D::robotRadius [m]; 0 or less: plannerRadiusForFootprint(
+	 * footprintHalfSize + footprintMarginCells cells, the grid's resolution). */
+	float robotRadius = 0.30f;
+	double footprintHalfSize = 0.25;  ///< used when robotRadius <= 0 [m]
+	double footprintMarginCells = 1;  ///< used when robotRadius <= 0 [cells]
 	/** PlannerSimple2D::occupancyThreshold: cells whose FREE probability is
 	 * below it are obstacles (unknown cells, 0.5, are traversable). */
 	float occupancyThreshold = 0.45f;
@@ -80,6 +95,19 @@ struct PlanResult
 };
 
 PlanResult planPath(
+	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPoint2D& start, const mrpt::math::TPoint2D& goal,
+	const PlanOptions& opts = {});
+
+/** The cells PlannerSimple2D does not enter with `opts` (1 = blocked, x + y *
+ * sizeX): cells whose free probability is at most occupancyThreshold, grown
+ * by ceil(radius / resolution) cells in a square, as the planner grows them. */
+std::vector<uint8_t> plannerBlockedCells(const mrpt::maps::COccupancyGridMap2D& grid, const PlanOptions& opts);
+
+/** When planPath() finds no path: a path from the cell outside the planner's
+ * grown obstacles nearest to `start` (start itself if it is outside) to the
+ * cell reachable from there that is nearest to `goal`. found = false if that
+ * cell is not closer to the goal than the start by more than a cell. */
+PlanResult planTowards(
 	const mrpt::maps::COccupancyGridMap2D& grid, const mrpt::math::TPoint2D& start, const mrpt::math::TPoint2D& goal,
 	const PlanOptions& opts = {});
 
@@ -107,12 +135,15 @@ struct ReactiveOptions
 	std::string baseConfig = "/usr/share/mrpt/config_files/navigation-ptgs/reactive2d_config.ini";
 	std::string cacheDir = "/tmp";  ///< PTG look-up table cache files go here
 	double robotHalfSize = 0.25;    ///< square robot footprint, half side [m]
-	/** The navigator's shape is the footprint grown by this [m] (its obstacles
-	 * are cell centres, so the footprint may reach half a cell into an
-	 * occupied cell). 0: one 5 cm cell, tried on gam-navbench, left 7 of the
-	 * first 25 ground-aware runs stuck in front of obstacles (2 in seeds 1-30
-	 * without it): the navigator finds fewer admissible motions. */
-	double footprintMargin = 0;
+	/** The navigator's shape is the footprint grown by this many cells of the
+	 * grid. Its obstacles are the centres of occupied cells, and a cell only
+	 * partly over a pit may be held free by the map while the ground truth
+	 * (and the wheel) has a drop there: the cell next to an occupied one.
+	 * Grown by one cell, the footprint keeps that neighbour's centre out.
+	 * 0 here (the navigator alone, runReactiveNavigation: with one cell it
+	 * stalls in front of the hatch from (0, 0.4), NAV_ERROR); the closed loop,
+	 * which backs out of such stalls, uses 1 (ClosedLoopOptions). */
+	double footprintMarginCells = 0;
 	double refDistance = 4.0;  ///< PTG range [m]
 	double maxSpeed = 0.5;     ///< [m/s]
 	double maxTime = 40;       ///< simulated seconds
@@ -146,8 +177,17 @@ ReactiveResult runReactiveNavigation(
 
 struct ClosedLoopOptions
 {
-	ReactiveOptions reactive;      ///< the navigator, the simulated robot, dt and the time limit
-	PlanOptions plan;              ///< the global planner (PlannerSimple2D) on the current grid
+	/** The navigator, the simulated robot, dt and the time limit; the
+	 * footprint grown by one cell (ReactiveOptions::footprintMarginCells). */
+	ReactiveOptions reactive = [] {
+		ReactiveOptions r;
+		r.footprintMarginCells = 1;
+		return r;
+	}();
+	/** The global planner (PlannerSimple2D) on the current grid; its radius
+	 * from the navigator's footprint (reactive.robotHalfSize and
+	 * footprintMarginCells) unless set > 0. */
+	PlanOptions plan{0.0f};
 	double frameInterval = 0.1;    ///< simulated time between depth frames [s] (10 Hz)
 	double replanInterval = 2.0;   ///< the global plan is redone at least this often [s]
 	double waypointSpacing = 1.0;  ///< waypoints along the planned path [m]
@@ -167,15 +207,46 @@ struct ClosedLoopOptions
 	 * navigator drive an arc into cells it has not looked at; and when the
 	 * planner finds no path on the current grid, it turns in place to look
 	 * around (and replans every 0.5 s) instead of following the stale plan.
-	 * Only where the turn is safe on the current grid: no obstacle cell
-	 * (ObstacleOptions::maxFreeProbability) within the circle the square
-	 * footprint sweeps (robotHalfSize * sqrt(2)) plus one cell; otherwise the
-	 * navigator, which checks its motions against the obstacles, drives. */
+	 * Only where the turn is safe on the current grid: no obstacle cell's
+	 * centre (ObstacleOptions::maxFreeProbability) within the circle the
+	 * navigator's footprint sweeps ((robotHalfSize + footprintMarginCells
+	 * cells) * sqrt(2): the navigator's own rule for its shape); otherwise
+	 * the navigator, which checks its motions against the obstacles, drives. */
 	bool turnInPlace = true;
 	double lookAhead = 0.6;    ///< [m]
 	double turnStartDeg = 60;  ///< [deg]
 	double turnStopDeg = 15;   ///< [deg]
 	double turnRate = 0.6;     ///< [rad/s]
+	/** Back out of a dead end. The navigator drives forward only; in front of
+	 * an obstacle, closer than the turn in place needs, it can stand still
+	 * with a plan around the obstacle (gam-navbench seeds 12 and 29: 0.4 m
+	 * before a box and an outlet, 14 s without a command). When the robot has
+	 * stood still for stallSeconds while the navigator drives, it backs up
+	 * straight at backupSpeed, only over cells the map holds free (p_free >
+	 * 0.5: seen; the camera looks forward, so behind the robot these are the
+	 * cells it saw on its way in), until the turn in place is clear or it has
+	 * backed up backupMax, and then turns towards the plan. */
+	bool backUpWhenStill = true;
+	double stallSeconds = 1.0;  ///< [s]
+	double backupSpeed = 0.2;   ///< [m/s]
+	double backupMax = 0.5;     ///< [m], the footprint's side
+	/** Before backing up, the robot follows the plan itself (pure pursuit of
+	 * the lookAhead point at followSpeed) for waypointSpacing metres if the
+	 * footprint is clear of obstacle cells (the navigator's rule) along the
+	 * next followCheck seconds of the arc, every step: in front of an outlet
+	 * with the plan around it, the navigator, whose target is the next
+	 * waypoint behind the outlet, stands still where the plan's arc is free. */
+	bool followPlanWhenStill = true;
+	double followSpeed = 0.25;  ///< [m/s]
+	double followCheck = 0.4;   ///< [s]
+	/** No path to the goal on the current grid (seed 41: cells around the goal
+	 * at 4 m that far-range noise holds occupied; seed 1009 of the doc: the
+	 * robot's own cell inside an obstacle grown by the planner's radius):
+	 * plan from the nearest cell outside the grown obstacles to the cell
+	 * reachable from there that is nearest to the goal, drive there (the
+	 * camera sees the goal's cells better from closer) and plan again.
+	 * Without such a cell, turn in place and look (turnInPlace). */
+	bool planTowardsGoalWhenNoPath = true;
 	/** Called after every simulation step with the simulated time and the
 	 * robot's TRUE pose; returning false ends the run there (a benchmark's
 	 * fall, collision or no progress). */
@@ -189,6 +260,11 @@ struct ClosedLoopResult : ReactiveResult
 	int plans = 0;                   ///< global plans computed (the first and the replans)
 	int failedPlans = 0;             ///< planner calls that found no path
 	double turningSeconds = 0;       ///< time spent turning in place (turnInPlace)
+	int partialPlans = 0;            ///< plans to the reachable cell nearest the goal (planTowardsGoalWhenNoPath)
+	int backups = 0;                 ///< times the robot backed out of a dead end
+	int planFollows = 0;             ///< times the robot followed the plan itself (followSpeed)
+	double followSeconds = 0;        ///< time spent following the plan itself
+	double backupSeconds = 0;        ///< time spent backing up
 	double finalOdometryError = 0;   ///< |odometry - true| at the end [m]
 	bool stoppedByCallback = false;  ///< opts.onStep returned false
 };

@@ -118,9 +118,12 @@ int main(int argc, char** argv)
 			ro.baseConfig = argReactiveCfg.getValue();
 			ro.cacheDir = std::filesystem::temp_directory_path().string();
 			gam::nav::ClosedLoopOptions co;
-			co.reactive = ro;
+			co.reactive.baseConfig = ro.baseConfig;
+			co.reactive.cacheDir = ro.cacheDir;
 			co.reactive.maxTime = 60;
 			co.plan = po;
+			// the closed loop's planner radius comes from the navigator's footprint unless given
+			if (!argRadius.isSet()) co.plan.robotRadius = 0;
 			co.seed = mo.seed;
 			gam::sim::SceneFile live = sf;
 			live.kinect.noise = mo.noise;

@@ -5,6 +5,7 @@
 // must contain the hatch.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <set>
@@ -149,4 +150,82 @@ TEST_F(NavExample, ObstaclePointsRespectTheRange)
 		pts.getPoint(i, x, y, z);
 		EXPECT_LE(std::hypot(x, y), 1.0 + 1e-4);
 	}
+}
+
+// PlannerSimple2D grows each obstacle cell by n = ceil(radius / resolution)
+// cells in a square; the radius for a square footprint of half side h must
+// make n + 1/2 cells reach h * sqrt(2), the footprint's circumcircle.
+TEST(NavPlannerRadius, FromTheFootprintsCircumcircleAndTheCellSize)
+{
+	// 0.25 * sqrt(2) = 0.3536 m = 7.07 cells of 5 cm: n = ceil(6.57) = 7, radius 6.5 cells
+	EXPECT_NEAR(gam::nav::plannerRadiusForFootprint(0.25, 0.05), 0.325, 1e-12);
+	// 0.30 * sqrt(2) = 0.4243 m = 8.49 cells: n = ceil(7.99) = 8, radius 7.5 cells
+	EXPECT_NEAR(gam::nav::plannerRadiusForFootprint(0.30, 0.05), 0.375, 1e-12);
+	// 10 cm cells: 3.54 cells, n = ceil(3.04) = 4, radius 3.5 cells
+	EXPECT_NEAR(gam::nav::plannerRadiusForFootprint(0.25, 0.10), 0.35, 1e-12);
+	// and PlannerSimple2D's ceil() gives back n
+	EXPECT_EQ(int(std::ceil(gam::nav::plannerRadiusForFootprint(0.30, 0.05) / 0.05)), 8);
+}
+
+namespace
+{
+/** 4 x 2 m of free cells (10 cm), one column of occupied cells at x = 3.0-3.1
+ * from y = 0 to 2 (a wall across the whole grid). */
+mrpt::maps::COccupancyGridMap2D gridWithAWallAcross()
+{
+	mrpt::maps::COccupancyGridMap2D g(0.0f, 4.0f, 0.0f, 2.0f, 0.1f);
+	g.fill(0.9f);
+	for (unsigned cy = 0; cy < g.getSizeY(); cy++) g.setCell(30, int(cy), 0.05f);
+	return g;
+}
+}  // namespace
+
+TEST(NavPlannerBlockedCells, TheObstacleGrownByCeilOfTheRadiusInASquare)
+{
+	mrpt::maps::COccupancyGridMap2D g(0.0f, 4.0f, 0.0f, 2.0f, 0.1f);
+	g.fill(0.9f);
+	g.setCell(20, 10, 0.05f);  // one occupied cell
+	gam::nav::PlanOptions po;
+	po.robotRadius = 0.25f;  // ceil(2.5) = 3 cells
+	const auto b = gam::nav::plannerBlockedCells(g, po);
+	const unsigned W = g.getSizeX();
+	EXPECT_EQ(std::count(b.begin(), b.end(), 1), 7 * 7);  // the 7 x 7 square around it
+	EXPECT_EQ(b[23 + 13 * W], 1);                         // corner of the square
+	EXPECT_EQ(b[24 + 10 * W], 0);                         // one cell further
+	EXPECT_EQ(b[20 + 6 * W], 0);
+}
+
+TEST(NavPlanTowards, NoPathToAGoalBehindAWallGivesThePathToTheNearestReachableCell)
+{
+	const auto g = gridWithAWallAcross();
+	gam::nav::PlanOptions po;
+	po.robotRadius = 0.15f;  // ceil(1.5) = 2 cells: the wall's column 30 blocks columns 28-32
+	const mrpt::math::TPoint2D start{0.55, 1.05}, goal{3.55, 1.05};
+	EXPECT_FALSE(gam::nav::planPath(g, start, goal, po).found);
+	const auto p = gam::nav::planTowards(g, start, goal, po);
+	ASSERT_TRUE(p.found);
+	// column 27 (x 2.7-2.8, centre 2.75) is the last one before the grown wall,
+	// and in it the row of the goal (centre 1.05) is the nearest cell
+	EXPECT_NEAR(p.path.back().x, 2.75, 1e-6);
+	EXPECT_NEAR(p.path.back().y, 1.05, 1e-6);
+}
+
+TEST(NavPlanTowards, FromInsideTheGrownObstaclesItStartsAtTheNearestCellOutside)
+{
+	const auto g = gridWithAWallAcross();
+	gam::nav::PlanOptions po;
+	po.robotRadius = 0.15f;
+	// start in column 29 (x 2.95), inside the wall grown by 2 cells, its neighbours
+	// 28 and 30 too: PlannerSimple2D finds no path even to a free cell behind it
+	const mrpt::math::TPoint2D start{2.95, 1.05}, back{0.55, 1.05};
+	EXPECT_FALSE(gam::nav::planPath(g, start, back, po).found);
+	// nothing nearer the goal (3.55) is reachable: column 27 is 0.8 m from it, the start 0.6 m
+	EXPECT_FALSE(gam::nav::planTowards(g, start, {3.55, 1.05}, po).found);
+	// towards a goal on the start's side the path begins at the nearest free cell:
+	// column 27, row 10 (0.2 m away; column 33 is 0.4 m away)
+	const auto p = gam::nav::planTowards(g, start, {0.25, 1.05}, po);
+	ASSERT_TRUE(p.found);
+	EXPECT_NEAR(p.path.front().x, 2.75, 1e-6);
+	EXPECT_NEAR(p.path.front().y, 1.05, 1e-6);
+	EXPECT_NEAR(p.path.back().x, 0.25, 1e-6);
 }
