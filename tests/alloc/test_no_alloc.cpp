@@ -326,7 +326,10 @@ TEST(NoAlloc, TwoCamerasInsertObservationsThreads1And2SteadyState)
 			total += n;
 			worst = std::max(worst, n);
 		}
-		if (threads > 1) EXPECT_GT(grid.parallelStats().ran_ahead, 0u);
+		if (threads > 1)
+		{
+			EXPECT_GT(grid.parallelStats().ran_ahead, 0u);
+		}
 		std::cout << "[alloc] two cameras, threads=" << threads << ": " << total << " allocations in " << kMeasured
 				  << " frame pairs (worst pair " << worst << ")\n";
 		EXPECT_EQ(worst, 0u) << "threads=" << threads
