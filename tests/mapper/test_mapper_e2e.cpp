@@ -171,6 +171,17 @@ void writeObsFormat(const std::string& path)
 	}
 }
 
+// The action of a sensory-frame rawlog: odometry moved dx along x.
+mrpt::obs::CActionCollection odometryStep(double dx)
+{
+	mrpt::obs::CActionCollection acts;
+	mrpt::obs::CActionRobotMovement2D mov;
+	mrpt::obs::CActionRobotMovement2D::TMotionModelOptions mm;
+	mov.computeFromOdometry(mrpt::poses::CPose2D(dx, 0, 0), mm);
+	acts.insert(mov);
+	return acts;
+}
+
 void writeSfFormat(const std::string& path)
 {
 	mrpt::io::CFileGZOutputStream f(path);
@@ -178,11 +189,7 @@ void writeSfFormat(const std::string& path)
 	double prev = 0;
 	for (double x : kPosesX)
 	{
-		mrpt::obs::CActionCollection acts;
-		mrpt::obs::CActionRobotMovement2D mov;
-		mrpt::obs::CActionRobotMovement2D::TMotionModelOptions mm;
-		mov.computeFromOdometry(mrpt::poses::CPose2D(x - prev, 0, 0), mm);
-		acts.insert(mov);
+		const mrpt::obs::CActionCollection acts = odometryStep(x - prev);
 		prev = x;
 		mrpt::obs::CSensoryFrame sf;
 		sf.insert(makeFrame(x));
@@ -207,11 +214,7 @@ void writeTwoCameraRawlogs(const std::string& obsPath, const std::string& sfPath
 		odo->sensorLabel = "ODOMETRY";
 		odo->odometry = mrpt::poses::CPose2D(x, 0, 0);
 		ao << *odo << *makeFrame(x) << *makeFrame(x, "DEPTH_DOWN", kDownCamera);
-		mrpt::obs::CActionCollection acts;
-		mrpt::obs::CActionRobotMovement2D mov;
-		mrpt::obs::CActionRobotMovement2D::TMotionModelOptions mm;
-		mov.computeFromOdometry(mrpt::poses::CPose2D(x - prev, 0, 0), mm);
-		acts.insert(mov);
+		const mrpt::obs::CActionCollection acts = odometryStep(x - prev);
 		prev = x;
 		mrpt::obs::CSensoryFrame sf;
 		sf.insert(makeFrame(x));
