@@ -207,7 +207,7 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 	{
 		const Plane ground = out.planes.front();
 		const size_t treeNodes = out.nodes.size();
-		fillPatches(grid, ground, hint, out);
+		fillPatches(grid, ground, out);
 		out.fill_nodes = out.nodes.size() - treeNodes;
 		if (out.fill_nodes)
 		{
@@ -221,8 +221,7 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 	out.status = out.planes.empty() ? GroundDetection::Status::NoConsensus : GroundDetection::Status::Ok;
 }
 
-void RrtGroundDetector::fillPatches(
-	const ElevationGrid& grid, const Plane& ground, const GroundSeedHint& hint, GroundDetection& out)
+void RrtGroundDetector::fillPatches(const ElevationGrid& grid, const Plane& ground, GroundDetection& out)
 {
 	// Breadth-first from every node off the ground plane (a ramp or a landing
 	// the tree reached): candidates s_x (along x) and s_y (along y) cells away
@@ -265,14 +264,9 @@ void RrtGroundDetector::fillPatches(
 	// Only within the range the map takes evidence from: a wide, noisy camera
 	// (a D435) has many floor nodes tilted by noise beyond it, which would use
 	// up the budget before the ramp ahead is tiled.
-	const double fill2 = hint.fill_range * hint.fill_range;
-	auto inRange = [&](double x, double y) {
-		const double dx = x - hint.sensor_x, dy = y - hint.sensor_y;
-		return dx * dx + dy * dy <= fill2;
-	};
 	m_fillQueue.clear();
 	for (uint32_t i = 0; i < out.nodes.size(); i++)
-		if (inRange(out.nodes[i].x, out.nodes[i].y) && offGround(out.nodes[i])) m_fillQueue.push_back(i);
+		if (m_hint.withinFillRange(out.nodes[i].x, out.nodes[i].y) && offGround(out.nodes[i])) m_fillQueue.push_back(i);
 	for (size_t q = 0; q < m_fillQueue.size() && out.nodes.size() < cap; q++)
 	{
 		const uint32_t pi = m_fillQueue[q];
@@ -282,7 +276,7 @@ void RrtGroundDetector::fillPatches(
 		{
 			if (out.nodes.size() >= cap) break;
 			const int cx = pcx + d[0] * sx, cy = pcy + d[1] * sy;
-			if (!g.inside(cx, cy) || !inRange(g.cx(cx), g.cy(cy)) || !windowFree(cx, cy)) continue;
+			if (!g.inside(cx, cy) || !m_hint.withinFillRange(g.cx(cx), g.cy(cy)) || !windowFree(cx, cy)) continue;
 			GroundNode node;
 			if (!childAt(grid, parent, int(pi), cx, cy, node)) continue;
 			addTreeNode(g, node, cx, cy, out);
@@ -848,16 +842,16 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 			// ground band and hid a 4 cm cable on the ramp) and beat either
 			// true plane.
 			m_absDist.clear();
-			const double range2 = m_hint.fill_range * m_hint.fill_range;
 			for (size_t i : r.inliers)
-			{
-				const double dx = pts[i].x() - m_hint.sensor_x, dy = pts[i].y() - m_hint.sensor_y;
-				if (dx * dx + dy * dy <= range2)
+				if (m_hint.withinFillRange(pts[i].x(), pts[i].y()))
 					m_absDist.push_back(std::abs(plane.signedDistance(pts[i].x(), pts[i].y(), pts[i].z())));
-			}
-			if (m_absDist.size() < 3)  // too few near nodes for a median: all of them
+			if (m_absDist.size() < 3)
+			{
+				// Too few near nodes for a median: all of them (each once).
+				m_absDist.clear();
 				for (size_t i : r.inliers)
 					m_absDist.push_back(std::abs(plane.signedDistance(pts[i].x(), pts[i].y(), pts[i].z())));
+			}
 			rp.inlier_distance = noiseBand(m_params.ransac_inlier_distance);
 			out.patch_inlier_distance = rp.inlier_distance;
 		}

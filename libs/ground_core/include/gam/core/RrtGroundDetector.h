@@ -198,14 +198,19 @@ struct GroundSeedHint
 {
 	double x = 0, y = 0;  ///< robot position in the grid frame
 	double floor_z = 0;   ///< expected floor height in the grid frame
-	/** fill_patches adds no node farther than this (2D) from (sensor_x,
-	 * sensor_y): the range within which the map takes evidence (the camera's
-	 * range of trust). Patches beyond it would judge cells that get none. */
+	/** The range (2D, from the sensor) within which the map takes evidence:
+	 * the camera's range of trust. fill_patches adds no node beyond it
+	 * (patches there would judge cells that get none), and only the ground
+	 * nodes within it give the extra patches' inlier distance (the noise
+	 * where the patches judge cells, not that of far floor). */
 	double fill_range = std::numeric_limits<double>::infinity();
-	/** fill_range also bounds the nodes whose spread about the ground plane
-	 * gives the extra patches' inlier distance: the noise where the patches
-	 * judge cells, not that of far floor no cell is judged against. */
-	double sensor_x = 0, sensor_y = 0;
+	double sensor_x = 0, sensor_y = 0;  ///< sensor position in the grid frame
+
+	bool withinFillRange(double px, double py) const
+	{
+		const double dx = px - sensor_x, dy = py - sensor_y;
+		return dx * dx + dy * dy <= fill_range * fill_range;
+	}
 };
 
 /** Algorithm 1's search window (rrt_variant = paper): centred on the centroid
@@ -322,7 +327,7 @@ class RrtGroundDetector
 	std::vector<int> m_cluster;
 	std::vector<size_t> m_bfs;
 	/** fill_patches: adds nodes over the ground off `ground` (see RrtGpdParams). */
-	void fillPatches(const ElevationGrid& grid, const Plane& ground, const GroundSeedHint& hint, GroundDetection& out);
+	void fillPatches(const ElevationGrid& grid, const Plane& ground, GroundDetection& out);
 	std::vector<uint32_t> m_fillQueue;
 	double m_resolution = 0.05;  ///< of the grid in detect() [m]
 	GroundSeedHint m_hint;       ///< of the frame in detect()
