@@ -350,6 +350,68 @@ TEST(DepthProjector, DecimationUsesEveryNthRowAndColumn)
 	EXPECT_EQ(proj.project(one.view(), camera(), T, f, grid, out), 1u);
 }
 
+TEST(DepthProjector, DecimatedSamplesAreThoseOfTheFullImageAtTheKeptPixels)
+{
+	// Reference: the full-resolution projection of the same image with every
+	// pixel off the decimation lattice (row or column not a multiple of n)
+	// set to 0 (no return): same pixels, same rays, same order, so the same
+	// samples bit for bit. Odd width (a scalar tail after the 8-wide loop),
+	// distortion, a pitched and rolled camera, depth and range images, both
+	// row loops; then a second camera, whose decimated ray table must follow.
+	std::mt19937 rng(11);
+	std::uniform_int_distribution<int> depth(0, 7000);
+	PinholeIntrinsics K = camera();
+	K.width = 61;
+	K.k1 = 0.05;
+	K.p2 = 0.001;
+	Image img(H, 61, 61);
+	for (auto& v : img.px) v = uint16_t(rng() % 9 == 0 ? 0 : depth(rng));
+	const RigidTransform T = pose(
+		(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitY()) *
+		 Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()))
+			.toRotationMatrix(),
+		{0.3, -0.2, 1.1});
+	ElevationGrid grid(makeGeometry(-2, -4, 0.05, 120, 160));
+	PinholeIntrinsics K2 = K;
+	K2.fx *= 1.1;
+	K2.k1 = 0;
+	for (int n : {2, 3})
+	{
+		Image lattice = img;
+		for (int r = 0; r < H; r++)
+			for (int c = 0; c < 61; c++)
+				if (r % n || c % n) lattice.at(r, c) = 0;
+		for (bool avx2 : {true, false})
+			for (bool isDepth : {true, false})
+			{
+				DepthProjector decimated, full;
+				decimated.setAllowAvx2(avx2);
+				for (const PinholeIntrinsics& cam : {K, K2})
+				{
+					ProjectionFilter f;
+					f.min_range = 0.4f;
+					f.z_min = -1.f;
+					f.z_max = 1.5f;
+					// (The flying-pixel filter reads neighbours n apart when
+					// decimated: a different rule on the lattice image.)
+					f.drop_flying_pixels = false;
+					BinnedPoints a, b;
+					f.decimation = n;
+					const size_t na = decimated.project(img.view(isDepth), cam, T, f, grid, a);
+					f.decimation = 1;
+					const size_t nb = full.project(lattice.view(isDepth), cam, T, f, grid, b);
+					ASSERT_EQ(na, nb) << "n=" << n;
+					ASSERT_GT(na, 20u);
+					for (size_t i = 0; i < na; i++)
+					{
+						ASSERT_EQ(a.cells()[i], b.cells()[i]) << i;
+						ASSERT_EQ(a.heights()[i], b.heights()[i]) << i;
+					}
+				}
+			}
+	}
+}
+
 TEST(DepthProjector, HeightBandAndRangeLimits)
 {
 	const RigidTransform T = pose(Eigen::Matrix3d::Identity(), {0, 0, 0.5});

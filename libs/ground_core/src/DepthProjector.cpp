@@ -26,6 +26,7 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 {
 	if (K == m_lutK && !m_rayY.empty()) return;
 	m_lutK = K;
+	m_decStep = 0;  // the decimated table follows the new one
 	const size_t n = size_t(K.width) * size_t(K.height);
 	m_rayY.resize(n);
 	m_rayZ.resize(n);
@@ -79,20 +80,28 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 	}
 }
 
+void DepthProjector::updateDecimatedLut(int dec)
+{
+	if (dec == m_decStep) return;
+	m_decStep = dec;
+	const int w = m_lutK.width, h = m_lutK.height;
+	const size_t cols = size_t((w + dec - 1) / dec), rows = size_t((h + dec - 1) / dec);
+	m_decRayY.resize(rows * cols);
+	m_decRayZ.resize(rows * cols);
+	m_decRayInvNorm.resize(rows * cols);
+	m_decRow.resize(cols);
+	for (size_t r = 0; r < rows; r++)
+		for (size_t k = 0; k < cols; k++)
+		{
+			const size_t from = r * size_t(dec) * size_t(w) + k * size_t(dec);
+			m_decRayY[r * cols + k] = m_rayY[from];
+			m_decRayZ[r * cols + k] = m_rayZ[from];
+			m_decRayInvNorm[r * cols + k] = m_rayInvNorm[from];
+		}
+}
+
 namespace
 {
-void projectRowDecimated(
-	const detail::RowParams& p, bool isDepth, const uint16_t* row, const float* ky, const float* kz,
-	const float* invNorm, int cols, int dec, int32_t* cell, float* z)
-{
-	for (int c = 0, k = 0; c < cols; c += dec, k++)
-	{
-		if (isDepth)
-			projectPixel<true>(p, row[c], ky[c], kz[c], 1.f, cell[k], z[k]);
-		else
-			projectPixel<false>(p, row[c], ky[c], kz[c], invNorm[c], cell[k], z[k]);
-	}
-}
 // A neighbour along the line within tol of the pixel: it lies on a surface
 // there (the far floor just past a step's edge continues along its row while
 // the column beyond it drops out; a mixed pixel has no such neighbour).
@@ -279,6 +288,7 @@ size_t DepthProjector::project(
 	p.units = img.units;
 
 	const int dec = std::max(1, f.decimation);
+	if (dec > 1) updateDecimatedLut(dec);
 	const size_t colsUsed = size_t((img.cols + dec - 1) / dec);
 	const size_t rowsUsed = size_t((img.rows + dec - 1) / dec);
 	const size_t start = out.size();
@@ -310,9 +320,20 @@ size_t DepthProjector::project(
 				projectRow(img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
 		}
 		else
-			projectRowDecimated(
-				p, img.is_depth, row, &m_rayY[lutRow], &m_rayZ[lutRow], &m_rayInvNorm[lutRow], img.cols, dec, rowCell,
-				rowZ);
+		{
+			// Every dec-th pixel of the row, next to each other: then the
+			// same row loop (same floats) as at full resolution.
+			const int used = int(colsUsed);
+			const size_t decRow = size_t(r / dec) * colsUsed;
+			uint16_t* pixels = m_decRow.data();
+			for (int k = 0; k < used; k++) pixels[k] = row[size_t(k) * size_t(dec)];
+			const float* invN = img.is_depth ? nullptr : &m_decRayInvNorm[decRow];
+			if (useAvx2)
+				detail::projectRowAvx2(
+					img.is_depth, p, pixels, &m_decRayY[decRow], &m_decRayZ[decRow], invN, used, rowCell, rowZ);
+			else
+				projectRow(img.is_depth, p, pixels, &m_decRayY[decRow], &m_decRayZ[decRow], invN, used, rowCell, rowZ);
+		}
 		// Only the valid pixels (and, with the filter, the ones it keeps) go out.
 		const uint8_t* kept = nullptr;
 		if (f.drop_flying_pixels)

@@ -137,10 +137,18 @@ class DepthProjector
 
    private:
 	void updateLut(const PinholeIntrinsics& K);
+	/** The decimated ray table for step `dec` > 1 (after updateLut). */
+	void updateDecimatedLut(int dec);
 	PinholeIntrinsics m_lutK;
 	// Ray table, one entry per pixel, as separate arrays so the row loop vectorizes.
 	std::vector<float> m_rayY, m_rayZ;  // y/x and z/x
 	std::vector<float> m_rayInvNorm;    // 1 / |(1, y/x, z/x)|, for range images
+	// With decimation n > 1: the ray table of every n-th row and column
+	// (contiguous, so that the row loop runs on it unchanged) and one row's
+	// used pixels.
+	int m_decStep = 0;
+	std::vector<float> m_decRayY, m_decRayZ, m_decRayInvNorm;
+	std::vector<uint16_t> m_decRow;
 	// One row of results before compaction (cell or -1, z).
 	std::vector<int32_t> m_rowCell;
 	std::vector<float> m_rowZ;
