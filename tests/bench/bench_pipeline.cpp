@@ -1,7 +1,7 @@
 // Per-stage and whole-pipeline timings of the ground-aware grid, and the two
 // comparison maps on the same frames, with Google Benchmark (Release build).
 //
-//   gam-bench [--frames=N] [--full-octomap=M] FILE.rawlog [FILE.rawlog ...] [benchmark flags]
+//   gam-bench [--frames=N] [--decimation=N] [--full-octomap=M] FILE.rawlog [FILE.rawlog ...] [benchmark flags]
 //
 // Each rawlog's 3D frames (up to N, default 20) are loaded once; every case
 // cycles through them. After the cases, a summary prints median and p95 ms
@@ -208,6 +208,7 @@ int roundsFor(const Dataset& d) { return std::max(1, int(40 / d.frames.size()));
 int main(int argc, char** argv)
 {
 	size_t maxFrames = 20;
+	int decimation = 1;  // > 1: also the default with every n-th pixel row and column
 	int fullOctomapFrames = 0;
 	std::vector<std::string> files;
 	std::vector<char*> bargs{argv[0]};
@@ -215,6 +216,8 @@ int main(int argc, char** argv)
 	{
 		if (std::strncmp(argv[i], "--frames=", 9) == 0)
 			maxFrames = size_t(std::max(1, std::atoi(argv[i] + 9)));
+		else if (std::strncmp(argv[i], "--decimation=", 13) == 0)
+			decimation = std::max(1, std::atoi(argv[i] + 13));
 		else if (std::strncmp(argv[i], "--full-octomap=", 15) == 0)
 			fullOctomapFrames = std::max(0, std::atoi(argv[i] + 15));
 		else if (std::strncmp(argv[i], "--", 2) == 0)
@@ -224,7 +227,8 @@ int main(int argc, char** argv)
 	}
 	if (files.empty())
 	{
-		std::cerr << "usage: gam-bench [--frames=N] [--full-octomap=M] FILE.rawlog [...] [benchmark flags]\n";
+		std::cerr << "usage: gam-bench [--frames=N] [--decimation=N] [--full-octomap=M] FILE.rawlog [...] [benchmark "
+					 "flags]\n";
 		return 2;
 	}
 	try
@@ -259,7 +263,7 @@ int main(int argc, char** argv)
 
 	// Each map once over the same frames; the ground-aware run also records its
 	// stages, and so does the same grid in paper mode (ism_model = rrt_variant = paper).
-	std::vector<StageSeries> stages(g_data.size()), paperStages(g_data.size());
+	std::vector<StageSeries> stages(g_data.size()), paperStages(g_data.size()), decimatedStages(g_data.size());
 	std::vector<double> groundAwareMedian(g_data.size());
 	std::printf("\nCPU: %s (one core per map; compare within a row)\n", cpuName().c_str());
 	std::printf(
@@ -280,6 +284,15 @@ int main(int argc, char** argv)
 				g.setGroundOptions(o);
 			},
 			[&](const CGroundAwareOccupancyGrid& g) { paperStages[k].add(g); });
+		if (decimation > 1)
+			timesOf<CGroundAwareOccupancyGrid>(
+				d, rounds, 0,
+				[&](CGroundAwareOccupancyGrid& g) {
+					auto o = g.groundOptions();
+					o.pipeline.projection.decimation = decimation;
+					g.setGroundOptions(o);
+				},
+				[&](const CGroundAwareOccupancyGrid& g) { decimatedStages[k].add(g); });
 		const auto hb = timesOf<CHeightBandOccupancyGrid>(d, rounds);
 		const auto om = timesOf<COctoMapGrid2D>(d, 1);
 		const double mga = quantile(ga, 0.5), mhb = quantile(hb, 0.5), mom = quantile(om, 0.5);
@@ -299,16 +312,20 @@ int main(int argc, char** argv)
 		std::snprintf(b, sizeof b, "%.3f / %.3f", quantile(v, 0.5), quantile(v, 0.95));
 		return std::string(b);
 	};
-	for (const auto* series : {&stages, &paperStages})
+	const std::string decimatedLabel = " (decimation " + std::to_string(decimation) + ")";
+	for (const auto* series : {&stages, &paperStages, &decimatedStages})
 		for (size_t k = 0; k < g_data.size(); k++)
 		{
+			if (series == &decimatedStages && decimation == 1) break;
 			const StageSeries& t = (*series)[k];
 			const char* camera = series == &paperStages ? "-" : gam::kCameraModelNames[int(t.camera)];
 			std::printf(
 				"| %s%s | %s | %s | %s | %s | %s | %s | %s | %s |\n", g_data[k].name.c_str(),
-				series == &paperStages ? " (paper mode)" : "", camera, mp(t.projection).c_str(), mp(t.outliers).c_str(),
-				mp(t.ground).c_str(), mp(t.ism).c_str(), mp(t.missing).c_str(), mp(t.update).c_str(),
-				mp(t.total).c_str());
+				series == &paperStages       ? " (paper mode)"
+				: series == &decimatedStages ? decimatedLabel.c_str()
+											 : "",
+				camera, mp(t.projection).c_str(), mp(t.outliers).c_str(), mp(t.ground).c_str(), mp(t.ism).c_str(),
+				mp(t.missing).c_str(), mp(t.update).c_str(), mp(t.total).c_str());
 		}
 
 	if (fullOctomapFrames > 0)
