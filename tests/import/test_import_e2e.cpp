@@ -804,5 +804,11 @@ TEST(GamImportRealRealSense, EaselFrameFromARoughGuessToAMap)
 	EXPECT_GT(noOffset.floorOcc, noOffset.floorKnown / 2);
 	score("range_of_trust", "false");
 	score("camera_model", "kinect_one");
+	// Every 2nd pixel row and column (the option for active-stereo cameras,
+	// doc/cameras.md): the floor stays within the 1 %.
+	const Score decimated = score("decimation", "2");
+	ASSERT_GT(decimated.floorKnown, 100u);
+	EXPECT_LE(double(decimated.floorOcc), 0.01 * double(decimated.floorKnown));
+	EXPECT_GE(double(decimated.objectsOcc), 0.9 * double(decimated.objects));
 }
 #endif
