@@ -415,6 +415,44 @@ TEST(InverseSensorModel, DeepSampleCountIsJudgedAgainstTheCellsSampleCount)
 	EXPECT_EQ(st.drop, 1u);
 }
 
+TEST(InverseSensorModel, ACellThatSitsLowAsAWholeHasNoDeepDrop)
+{
+	// A cell whose samples all sit low -- the plane's misfit on a ramp, or a
+	// stereo camera's error shared by the samples of one matching window --
+	// has samples below -T for that reason: 24 at -0.026 and 6 at -0.0328.
+	// By hand (the cell of DeepSamplesBeyondTheFloorNoiseMakeADrop, sensor at
+	// (0, 0, 1) over z = 0, the model's noise): mean dMean = (24 * -0.026 + 6 *
+	// -0.0328) / 30 = -0.02736; r = sqrt(1.025^2 + 0.025^2 + 1.02736^2) =
+	// 1.451454; sigma = (0.0012 + 0.0019 r^2) / r = 0.0035845; s = sqrt(sigma^2
+	// + 0.01^2) = 0.0106230; T = 3 s = 0.0318691; one-sample band 0.03 + 3 sigma
+	// = 0.0407536 > 0.0328, the mean's band 0.03 + 0.0107536 / sqrt(30) =
+	// 0.0319633 > 0.02736: ground by both; 6 samples below -T.
+	// From the plane's noise alone, p0 = Phi(-3) = 0.0013499 and P(X >= 6 of
+	// 30) = 3.5e-12: a drop. From the cell's own level, a sample lies below -T
+	// with p0 = Phi(-(T + dMean) / sigma) = Phi(-1.2579) = 0.10421, and P(X >= 6
+	// of 30) = 0.0857 > 0.0013499: no drop (the larger p0 is taken).
+	const double pLevel = ism::normalTail((0.0318691 - 0.02736) / 0.0035845);
+	EXPECT_NEAR(pLevel, 0.10421, 1e-4);
+	EXPECT_NEAR(ism::binomialTail(30, pLevel, 6), 0.0857, 2e-4);
+	EXPECT_NEAR(ism::binomialTail(30, ism::normalTail(3.0), 6), 3.5e-12, 0.1e-12);
+	InverseSensorModel ism(deepParams());
+	IsmStats st;
+	BinnedPoints b;
+	std::vector<float> samples(24, -0.026f);
+	samples.insert(samples.end(), 6, -0.0328f);
+	const ElevationGrid low = deepCellFrame(0, samples, b);
+	ism.compute(low, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 0u);
+	EXPECT_EQ(st.ground, 1u);
+	// The same 6 deep samples in a cell that sits on the floor (24 at 0: mean
+	// -0.00656, (T + dMean) / sigma = 7.05, p0 = Phi(-3) again): a drop.
+	std::vector<float> onFloor(24, 0.f);
+	onFloor.insert(onFloor.end(), 6, -0.0328f);
+	const ElevationGrid hole = deepCellFrame(0, onFloor, b);
+	ism.compute(hole, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 1u);
+}
+
 TEST(InverseSensorModel, DeepSamplesRejectedByTheThreeSigmaRuleDoNotCount)
 {
 	// 60 floor samples, 2 at -T - 1 mm (about -0.0328) and 3 spikes at -0.3.

@@ -430,7 +430,16 @@ void InverseSensorModel::compute(
 				{
 					// signedDistance = c (z - heightAt) for a unit normal.
 					m_tailLo[idx] = float(pl.heightAt(x, y) - T / pl.c);
-					m_tailCandidates.push_back({idx, TailKind::Deep, float(ism::normalTail(T / s)), false});
+					// A sample's chance to lie below -T: from the plane's noise
+					// (s), or -- when the whole cell sits low, by the plane's
+					// misfit or a stereo camera's error shared by its matching
+					// window -- from the cell's own level dMean with one
+					// sample's noise sigma, whichever is larger: such a cell
+					// has samples below -T for that reason, a hole's cell has
+					// them far below its level.
+					const double p0 =
+						std::max(ism::normalTail(T / s), sigma > 0 ? ism::normalTail((T + dMean) / sigma) : 0.0);
+					m_tailCandidates.push_back({idx, TailKind::Deep, float(p0), false});
 				}
 			}
 		}
