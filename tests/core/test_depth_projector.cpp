@@ -350,6 +350,35 @@ TEST(DepthProjector, DecimationUsesEveryNthRowAndColumn)
 	EXPECT_EQ(proj.project(one.view(), camera(), T, f, grid, out), 1u);
 }
 
+namespace
+{
+// Random depths (one in 9 missing, some beyond any range) on a 61-pixel-wide
+// camera (not a multiple of 8: the row loops' scalar tail) with lens
+// distortion, pitched, rolled and yawed.
+struct RandomScene
+{
+	PinholeIntrinsics K;
+	Image img;
+	RigidTransform T;
+};
+RandomScene randomDistortedScene(unsigned seed)
+{
+	std::mt19937 rng(seed);
+	std::uniform_int_distribution<int> depth(0, 7000);
+	RandomScene r{camera(), Image(H, 61, 61), {}};
+	r.K.width = 61;
+	r.K.k1 = 0.05;
+	r.K.p2 = 0.001;
+	for (auto& v : r.img.px) v = uint16_t(rng() % 9 == 0 ? 0 : depth(rng));
+	r.T = pose(
+		(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitY()) *
+		 Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()))
+			.toRotationMatrix(),
+		{0.3, -0.2, 1.1});
+	return r;
+}
+}  // namespace
+
 TEST(DepthProjector, DecimatedSamplesAreThoseOfTheFullImageAtTheKeptPixels)
 {
 	// Reference: the full-resolution projection of the same image with every
@@ -358,19 +387,10 @@ TEST(DepthProjector, DecimatedSamplesAreThoseOfTheFullImageAtTheKeptPixels)
 	// samples bit for bit. Odd width (a scalar tail after the 8-wide loop),
 	// distortion, a pitched and rolled camera, depth and range images, both
 	// row loops; then a second camera, whose decimated ray table must follow.
-	std::mt19937 rng(11);
-	std::uniform_int_distribution<int> depth(0, 7000);
-	PinholeIntrinsics K = camera();
-	K.width = 61;
-	K.k1 = 0.05;
-	K.p2 = 0.001;
-	Image img(H, 61, 61);
-	for (auto& v : img.px) v = uint16_t(rng() % 9 == 0 ? 0 : depth(rng));
-	const RigidTransform T = pose(
-		(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitY()) *
-		 Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()))
-			.toRotationMatrix(),
-		{0.3, -0.2, 1.1});
+	const RandomScene scene = randomDistortedScene(11);
+	const PinholeIntrinsics& K = scene.K;
+	const Image& img = scene.img;
+	const RigidTransform& T = scene.T;
 	ElevationGrid grid(makeGeometry(-2, -4, 0.05, 120, 160));
 	PinholeIntrinsics K2 = K;
 	K2.fx *= 1.1;
@@ -606,19 +626,10 @@ TEST(DepthProjector, Avx2AndBaselineRowLoopsAgreeBitForBit)
 	if (!DepthProjector::avx2Available()) GTEST_SKIP() << "no AVX2 on this CPU or build";
 	// Random depths (some 0, some beyond the range, odd widths that leave a
 	// scalar tail), a pitched, rolled camera, range and depth images, distortion.
-	std::mt19937 rng(7);
-	std::uniform_int_distribution<int> depth(0, 7000);
-	PinholeIntrinsics K = camera();
-	K.width = 61;  // not a multiple of 8
-	K.k1 = 0.05;
-	K.p2 = 0.001;
-	Image img(H, 61, 61);
-	for (auto& v : img.px) v = uint16_t(rng() % 9 == 0 ? 0 : depth(rng));
-	const RigidTransform T = pose(
-		(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitY()) *
-		 Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitX()))
-			.toRotationMatrix(),
-		{0.3, -0.2, 1.1});
+	const RandomScene scene = randomDistortedScene(7);
+	const PinholeIntrinsics& K = scene.K;
+	const Image& img = scene.img;
+	const RigidTransform& T = scene.T;
 	ProjectionFilter f;
 	f.min_range = 0.4f;
 	f.z_min = -1.f;
