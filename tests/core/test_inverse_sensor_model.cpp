@@ -415,11 +415,12 @@ TEST(InverseSensorModel, DeepSampleCountIsJudgedAgainstTheCellsSampleCount)
 	EXPECT_EQ(st.drop, 1u);
 }
 
-TEST(InverseSensorModel, ACellThatSitsLowAsAWholeHasNoDeepDrop)
+TEST(InverseSensorModel, ACellThatSitsLowAsAWholeHasNoDeepDropWithAStereoCamera)
 {
-	// A cell whose samples all sit low -- the plane's misfit on a ramp, or a
-	// stereo camera's error shared by the samples of one matching window --
-	// has samples below -T for that reason: 24 at -0.026 and 6 at -0.0328.
+	// A stereo camera's samples of one matching window share part of their
+	// error, so a whole cell can sit low (on a ramp, the plane's misfit adds
+	// to it) and has samples below -T for that reason: 24 at -0.026 and 6 at
+	// -0.0328.
 	// By hand (the cell of DeepSamplesBeyondTheFloorNoiseMakeADrop, sensor at
 	// (0, 0, 1) over z = 0, the model's noise): mean dMean = (24 * -0.026 + 6 *
 	// -0.0328) / 30 = -0.02736; r = sqrt(1.025^2 + 0.025^2 + 1.02736^2) =
@@ -435,12 +436,19 @@ TEST(InverseSensorModel, ACellThatSitsLowAsAWholeHasNoDeepDrop)
 	EXPECT_NEAR(pLevel, 0.10421, 1e-4);
 	EXPECT_NEAR(ism::binomialTail(30, pLevel, 6), 0.0857, 2e-4);
 	EXPECT_NEAR(ism::binomialTail(30, ism::normalTail(3.0), 6), 3.5e-12, 0.1e-12);
-	InverseSensorModel ism(deepParams());
 	IsmStats st;
 	BinnedPoints b;
 	std::vector<float> samples(24, -0.026f);
 	samples.insert(samples.end(), 6, -0.0328f);
 	const ElevationGrid low = deepCellFrame(0, samples, b);
+	// A time-of-flight camera (independent samples, the default): the plane's
+	// p0 alone, a drop.
+	InverseSensorModel tof(deepParams());
+	tof.compute(low, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 1u);
+	// The D435 (a correlated part in its noise): no drop.
+	InverseSensorModel ism(deepParams());
+	ism.setCameraNoise(cameraNoisePreset(CameraModel::D435), 600);
 	ism.compute(low, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
 	EXPECT_EQ(st.deep_drops, 0u);
 	EXPECT_EQ(st.ground, 1u);

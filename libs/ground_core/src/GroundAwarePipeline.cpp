@@ -179,6 +179,7 @@ const FrameResult& GroundAwarePipeline::process(
 
 	// 3. Evidence, within the range of trust of the camera.
 	m_result.sensor = frame.sensor_position;
+	m_ism.setCameraNoise(noise, frame.intrinsics.fx);
 	m_ism.compute(m_grid, m_result.detection, m_result.sensor, evidenceRange, m_result.ism, &m_bins);
 	const auto t4 = clk::now();
 

@@ -375,6 +375,8 @@ void InverseSensorModel::compute(
 	const double res = g.resolution;
 	const bool haveSamples = samples && !samples->empty();
 	const bool deepTest = m_params.deep_sample_test && haveSamples && m_params.noise_sigmas > 0;
+	// Whether the camera's samples share part of their error (see the deep-sample test).
+	const bool sharedNoise = m_camera.correlated(1.0, m_fx) > 0;
 	m_tailCandidates.clear();
 
 	// Pass 1: every observed voxel updates its own cell.
@@ -431,14 +433,14 @@ void InverseSensorModel::compute(
 					// signedDistance = c (z - heightAt) for a unit normal.
 					m_tailLo[idx] = float(pl.heightAt(x, y) - T / pl.c);
 					// A sample's chance to lie below -T: from the plane's noise
-					// (s), or -- when the whole cell sits low, by the plane's
-					// misfit or a stereo camera's error shared by its matching
-					// window -- from the cell's own level dMean with one
-					// sample's noise sigma, whichever is larger: such a cell
-					// has samples below -T for that reason, a hole's cell has
-					// them far below its level.
-					const double p0 =
-						std::max(ism::normalTail(T / s), sigma > 0 ? ism::normalTail((T + dMean) / sigma) : 0.0);
+					// (s). A camera whose samples share part of their error (a
+					// stereo camera's matching window) can put a whole cell low;
+					// there it is the larger of that and the chance from the
+					// cell's own level dMean with one sample's noise sigma: such
+					// a cell has samples below -T for that reason, a hole's cell
+					// has them far below its level.
+					double p0 = ism::normalTail(T / s);
+					if (sharedNoise && sigma > 0) p0 = std::max(p0, ism::normalTail((T + dMean) / sigma));
 					m_tailCandidates.push_back({idx, TailKind::Deep, float(p0), false});
 				}
 			}

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "gam/core/CameraNoise.h"
 #include "gam/core/ElevationGrid.h"
 #include "gam/core/Parameters.h"
 #include "gam/core/RrtGroundDetector.h"
@@ -296,6 +297,15 @@ class InverseSensorModel
 	explicit InverseSensorModel(const IsmParams& p = {}) { setParams(p); }
 	/** Validates (throws std::invalid_argument), then keeps `p`: compute()
 	 * runs with parameters checked once, not on every frame. */
+	/** The camera that took the frame (focal length fx [px]): with a
+	 * correlated part in its noise (a stereo camera), the deep-sample test
+	 * also judges a cell from its own level. Default: none (independent
+	 * samples, a time-of-flight camera). */
+	void setCameraNoise(const CameraNoise& noise, double fx)
+	{
+		m_camera = noise;
+		m_fx = fx;
+	}
 	void setParams(const IsmParams& p)
 	{
 		p.validate();
@@ -357,6 +367,8 @@ class InverseSensorModel
 	const Plane& choosePlane(const GroundDetection& det, const ElevationCell& c, double x, double y, int block) const;
 	/** P(occ) of an obstacle or drop voxel: eq. (4)-(5) of its density. */
 	float obstacleEvidence(const ElevationCell& c, double resolution) const;
+	CameraNoise m_camera;  ///< of the frame (setCameraNoise)
+	double m_fx = 0;
 	/** Samples an obstacle (min_obstacle_points) or a drop (min_drop_points) needs. */
 	uint32_t minPoints(VoxelClass c, bool onPatch) const
 	{
