@@ -859,7 +859,9 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		// its side (13 nodes, 9.5 cm).
 		const double window = std::max(m_params.neighbourhood_x, m_params.neighbourhood_y) * m_resolution;
 		const bool lineLike = minorStd <= 0.5 * window;
-		if (k > 0 && lineLike)
+		// A line that continues an accepted extra patch below its plane is that
+		// patch's crest (continuesPatchAtCrest): a ground patch all the same.
+		if (k > 0 && lineLike && !(k > 1 && continuesPatchAtCrest(r.plane, out, rp.inlier_distance)))
 		{
 			m_flag.assign(remaining.size(), 0);
 			for (size_t i : r.inliers) m_flag[i] = 1;
@@ -964,6 +966,42 @@ Plane RrtGroundDetector::patchFromNodesAndNormals(
 	const Eigen::Vector2d g =
 		combinedPatchGradient(gradient(nodesPlane), rss / std::max(1.0, n - 3.0), spread, m_localGradients);
 	return Plane::fromNormalAndPoint(Eigen::Vector3d(-g.x(), -g.y(), 1.0), c);
+}
+
+bool RrtGroundDetector::continuesPatchAtCrest(const Plane& plane, const GroundDetection& out, double tol) const
+{
+	// A line of nodes (m_ransac's inliers, the nodes m_remaining[i]) next to
+	// an accepted extra patch (a ramp): the cable or the cable protector
+	// lying across it stands above the ramp's plane; the first rows of the
+	// landing past the ramp's top lie below the ramp's plane extended (a
+	// convex bend), and so does the crest of any hump. Those first rows are what the
+	// range of trust leaves of a landing: two rows of filled nodes (a minor
+	// std of 7.5 cm, a line) in ramp_8deg_0.7m seen by a D455 1 m up (range
+	// of trust 2.64 m), where the landing's cells were then judged against
+	// the ramp's plane extended, 1-3 cm above them: drops. A line is a
+	// crest if every one of its nodes within d_n of any accepted extra
+	// patch's nodes lies below that patch's plane, and two such pairs of
+	// neighbouring nodes meet as in joinsAcceptedPlane() (the line's plane
+	// changes side of the patch between them, or is within the noise band
+	// `tol` of it at the line's node, or within 2 tol at the patch's node).
+	const double link2 = m_params.expansion_distance * m_params.expansion_distance;
+	int joins = 0;
+	for (size_t i : m_ransac.inliers)
+	{
+		const GroundNode& p = out.nodes[m_remaining[i]];
+		for (const GroundNode& q : out.nodes)
+		{
+			if (q.plane_id < 1) continue;
+			const double dx = double(p.x) - q.x, dy = double(p.y) - q.y;
+			if (dx * dx + dy * dy > link2) continue;
+			const Plane& Q = out.planes[size_t(q.plane_id)];
+			if (double(p.z) >= Q.heightAt(p.x, p.y)) return false;  // on top of a patch: a cable, a kerb
+			const double atP = plane.heightAt(p.x, p.y) - Q.heightAt(p.x, p.y);
+			const double atQ = plane.heightAt(q.x, q.y) - Q.heightAt(q.x, q.y);
+			joins += (atP > 0) != (atQ > 0) || std::abs(atP) <= tol || std::abs(atQ) <= 2 * tol;
+		}
+	}
+	return joins >= 2;
 }
 
 void RrtGroundDetector::acceptPatch(const Plane& plane, size_t begin, size_t end, GroundDetection& out)

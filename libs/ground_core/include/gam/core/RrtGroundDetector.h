@@ -342,6 +342,10 @@ class RrtGroundDetector
 	Plane patchFromNodesAndNormals(
 		const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const Eigen::Matrix2d& spread);
 	std::vector<Eigen::Vector2d> m_localGradients;
+	/** True if m_ransac's inliers, a line of nodes with plane `plane`, are
+	 * the crest of an accepted extra patch: below its plane wherever they
+	 * are within d_n of its nodes, and joining it (see fitPlanes). */
+	bool continuesPatchAtCrest(const Plane& plane, const GroundDetection& out, double tol) const;
 	/** Appends `plane` as a patch held by the nodes m_patchNodes[begin, end). */
 	void acceptPatch(const Plane& plane, size_t begin, size_t end, GroundDetection& out);
 	std::vector<int> m_cluster;
