@@ -572,6 +572,46 @@ TEST(InverseSensorModel, ADropBelowAPatchTakesTheObstacleCount)
 	EXPECT_GT(ism.evidence()[cell], 0.5f) << "two samples below the floor plane: a drop";
 }
 
+TEST(InverseSensorModel, PatchAppliesWithinTheSupportRadiusOfItsNodes)
+{
+	// The default frame grid: x, y from -5 m, 5 cm cells; support in blocks
+	// of 4 cells (0.2 m). One node of patch 1 at (1.025, 0.025): its block is
+	// floor((1.025 + 5) / 0.2) = 30 along x, floor((0.025 + 5) / 0.2) = 25
+	// along y; plane_support_radius 0.4 m = ceil(0.4 / 0.2) = 2 blocks, so the
+	// patch applies on blocks 28-32 x 23-27: cells 112-131 x 92-111, i.e.
+	// x in [0.6, 1.6) m, y in [-0.4, 0.6) m.
+	GroundDetection det = handDetection(kFloor);
+	det.planes.push_back(Plane{0, 0, 1, -0.20});
+	det.plane_support.push_back(10);
+	GroundNode node;
+	node.x = 1.025f;
+	node.y = 0.025f;
+	node.z = 0.20f;
+	node.plane_id = 1;
+	det.nodes.push_back(node);
+	ElevationGrid grid;
+	BinnedPoints b;
+	gamtest::sampleColumns(grid, 1.0, 1.05, 0.0, 0.05, 0.2, 0.2, 0.1, b);
+	gamtest::insertAll(grid, b);
+	InverseSensorModel ism;
+	IsmStats st;
+	ism.compute(grid, det, {0, 0, 1}, 5.0, st);
+	const GridGeometry& g = grid.geometry();
+	auto at = [&](double x, double y) { return ism.patchApplies(uint32_t(g.index(g.ix(x), g.iy(y))), g.nx); };
+	EXPECT_TRUE(at(1.025, 0.025));
+	EXPECT_TRUE(at(0.625, -0.375));  // cells 112, 92: the corner block
+	EXPECT_TRUE(at(1.575, 0.575));   // cells 131, 111
+	EXPECT_FALSE(at(1.625, 0.025));  // cell 132: block 33
+	EXPECT_FALSE(at(0.575, 0.025));  // cell 111: block 27
+	EXPECT_FALSE(at(1.025, 0.625));  // cell 112 along y: block 28
+	// Without patches (one plane, or local_planes = false) nothing applies.
+	IsmParams noLocal;
+	noLocal.local_planes = false;
+	InverseSensorModel ism2(noLocal);
+	ism2.compute(grid, det, {0, 0, 1}, 5.0, st);
+	EXPECT_FALSE(ism2.patchApplies(uint32_t(g.index(g.ix(1.025), g.iy(0.025))), g.nx));
+}
+
 namespace
 {
 // Frame of test ISM-1 (grid -5..5 m, 5 cm). Sensor at (0, 0, 1), ground z = 0.

@@ -492,3 +492,39 @@ TEST(RrtGroundDetector, SparseFloorNeedsIdw)
 	EXPECT_NEAR(out.plane().heightAt(0, 0), 0.0, 0.005);
 	EXPECT_LT(rad2deg(out.plane().tiltAngle()), 0.5);
 }
+
+TEST(RrtGroundDetector, PatchSlopeWeighsNodeCentresAndLocalPlanesByTheirPrecision)
+{
+	// Four nodes of a patch spread 1 m along x (variance 1.0 m^2) and 0.1 m
+	// across (variance 0.01 m^2); the centres' plane rises 0.12 along x and
+	// -0.03 along y with a residual variance of 0.0004 m^2 (2 cm rms).
+	// Their local planes' slopes: along x 0.09, 0.11, 0.09, 0.11 (mean 0.10,
+	// population variance 0.0001), along y 0.02, 0, 0.02, 0 (mean 0.01,
+	// population variance 0.0001).
+	const Eigen::Vector2d nodes(0.12, -0.03);
+	Eigen::Matrix2d spread;
+	spread << 1.0, 0.0, 0.0, 0.01;
+	const std::vector<Eigen::Vector2d> local{{0.09, 0.02}, {0.11, 0.0}, {0.09, 0.02}, {0.11, 0.0}};
+	const Eigen::Vector2d g = combinedPatchGradient(nodes, 0.0004, spread, local);
+	// Variance of the mean local slope: 0.0001 / (4 - 1) = 3.333e-5 on both
+	// axes. Of the centres' slope: 0.0004 / (4 x 1.0) = 1e-4 along x,
+	// 0.0004 / (4 x 0.01) = 0.01 across.
+	// x: (0.10 / 3.333e-5 + 0.12 / 1e-4) / (1 / 3.333e-5 + 1 / 1e-4)
+	//    = (3000 + 1200) / (30000 + 10000) = 0.105
+	// y: (0.01 / 3.333e-5 - 0.03 / 0.01) / (30000 + 100) = 297 / 30100 = 0.0098671
+	EXPECT_NEAR(g.x(), 0.105, 1e-9);
+	EXPECT_NEAR(g.y(), 297.0 / 30100.0, 1e-9);
+
+	// A line of nodes (no spread across it): the roll is the local planes'
+	// alone (0.01), the slope along the line still weighted (0.105).
+	spread << 1.0, 0.0, 0.0, 0.0;
+	const Eigen::Vector2d line = combinedPatchGradient(nodes, 0.0004, spread, local);
+	EXPECT_NEAR(line.x(), 0.105, 1e-9);
+	EXPECT_NEAR(line.y(), 0.01, 1e-9);
+
+	// Centres exactly on their plane: it wins outright.
+	spread << 1.0, 0.0, 0.0, 0.01;
+	const Eigen::Vector2d exact = combinedPatchGradient(nodes, 0.0, spread, local);
+	EXPECT_NEAR(exact.x(), 0.12, 1e-12);
+	EXPECT_NEAR(exact.y(), -0.03, 1e-12);
+}

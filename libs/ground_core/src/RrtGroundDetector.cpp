@@ -9,6 +9,43 @@
 
 namespace gam
 {
+Eigen::Vector2d combinedPatchGradient(
+	const Eigen::Vector2d& nodesGradient, double residualVariance, const Eigen::Matrix2d& spread,
+	const std::vector<Eigen::Vector2d>& localGradients)
+{
+	const double n = double(localGradients.size());
+	if (n < 1) return nodesGradient;
+	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(spread);
+	Eigen::Vector2d g = Eigen::Vector2d::Zero();
+	for (int axis = 0; axis < 2; axis++)
+	{
+		const Eigen::Vector2d e = es.eigenvectors().col(axis);
+		double sum = 0, sum2 = 0;
+		for (const Eigen::Vector2d& lg : localGradients)
+		{
+			const double v = lg.dot(e);
+			sum += v;
+			sum2 += v * v;
+		}
+		const double local = sum / n, nodes = nodesGradient.dot(e);
+		// Variance of the mean of the local slopes (sample variance / n) and
+		// of the centres' least-squares slope along e.
+		const double varLocal = n > 1 ? std::max(0.0, sum2 / n - local * local) / (n - 1.0) : 0.0;
+		const double lambda = es.eigenvalues()(axis);
+		const bool nodesKnown = lambda > 0 && std::isfinite(residualVariance);
+		const double varNodes = nodesKnown ? residualVariance / (n * lambda) : 0.0;
+		double along;
+		if (!nodesKnown || !(varLocal > 0))
+			along = local;  // no spread along e (a line of nodes), or local slopes that agree exactly
+		else if (!(varNodes > 0))
+			along = nodes;  // centres exactly on their plane
+		else
+			along = (local / varLocal + nodes / varNodes) / (1.0 / varLocal + 1.0 / varNodes);
+		g += along * e;
+	}
+	return g;
+}
+
 void RrtGpdParams::validate() const
 {
 	checkParamRanges(*this, "");
@@ -311,6 +348,7 @@ void RrtGroundDetector::reserveScratch(const GridGeometry& g)
 	m_candidates.reserve(maxNodes);
 	m_fillQueue.reserve(maxNodes);
 	m_absDist.reserve(maxNodes);
+	m_localGradients.reserve(maxNodes);
 	m_cluster.reserve(maxNodes);
 	m_bfs.reserve(maxNodes);
 	m_patchNodes.reserve(maxNodes);
@@ -790,8 +828,16 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 
 		Plane plane = r.plane;
 		// Nearly collinear node sets (a corridor crossed by one line of nodes)
-		// leave the roll about that line undetermined: take the mean of the
-		// inliers' local normals instead, which every node measured itself.
+		// leave the roll about that line undetermined: the inliers' local
+		// normals, which every node measured itself, measure it too. Each axis
+		// takes the two measurements weighted by their measured precision
+		// (combinedPatchGradient). The mean of the local normals alone, each
+		// fitted over one s_x x s_y window that a stereo camera's correlated
+		// noise tilts as a whole, put the 8 deg ramp 0.7 m wide of
+		// ramp_8deg_0.7m seen by a D435 at 7.1 deg with 0.8 deg of roll in one
+		// frame (over 11 frames the local slopes averaged 0.127, the node
+		// centres' planes 0.134; true 0.1405), and the cells along its foot
+		// 1-2 cm below it: drops.
 		Eigen::Vector2d mean2 = Eigen::Vector2d::Zero();
 		for (size_t i : r.inliers) mean2 += pts[i].head<2>();
 		mean2 /= double(r.inliers.size());
@@ -813,24 +859,16 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 		// its side (13 nodes, 9.5 cm).
 		const double window = std::max(m_params.neighbourhood_x, m_params.neighbourhood_y) * m_resolution;
 		const bool lineLike = minorStd <= 0.5 * window;
-		if (k > 0 && lineLike)
+		// A line that continues an accepted extra patch below its plane is that
+		// patch's crest (continuesPatchAtCrest): a ground patch all the same.
+		if (k > 0 && lineLike && !(k > 1 && continuesPatchAtCrest(r.plane, out, rp.inlier_distance)))
 		{
 			m_flag.assign(remaining.size(), 0);
 			for (size_t i : r.inliers) m_flag[i] = 1;
 			keepUnflagged();
 			continue;
 		}
-		if (!paper() && minorStd < 0.5 * m_params.expansion_distance)
-		{
-			Eigen::Vector3d n = Eigen::Vector3d::Zero(), c = Eigen::Vector3d::Zero();
-			for (size_t i : r.inliers)
-			{
-				n += out.nodes[remaining[i]].local.normal();
-				c += pts[i];
-			}
-			plane = Plane::fromNormalAndPoint(n, c / double(r.inliers.size()));
-		}
-
+		if (!paper() && minorStd < 0.5 * m_params.expansion_distance) plane = patchFromNodesAndNormals(out, pts, C);
 		if (k == 0)
 		{
 			// The extra patches' inlier distance, from this frame's noise and
@@ -904,6 +942,66 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 				more = true;
 			}
 	}
+}
+
+Plane RrtGroundDetector::patchFromNodesAndNormals(
+	const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const Eigen::Matrix2d& spread)
+{
+	const std::vector<size_t>& in = m_ransac.inliers;
+	const double n = double(in.size());
+	Eigen::Vector3d c = Eigen::Vector3d::Zero();
+	for (size_t i : in) c += pts[i];
+	c /= n;
+	const Plane& nodesPlane = m_ransac.plane;
+	double rss = 0;
+	for (size_t i : in)
+	{
+		const double d = nodesPlane.signedDistance(pts[i].x(), pts[i].y(), pts[i].z());
+		rss += d * d;
+	}
+	auto gradient = [](const Plane& pl) { return Eigen::Vector2d(-pl.a / pl.c, -pl.b / pl.c); };
+	m_localGradients.clear();
+	for (size_t i : in) m_localGradients.push_back(gradient(out.nodes[m_remaining[i]].local));
+	// The residual variance of a fit of 3 parameters.
+	const Eigen::Vector2d g =
+		combinedPatchGradient(gradient(nodesPlane), rss / std::max(1.0, n - 3.0), spread, m_localGradients);
+	return Plane::fromNormalAndPoint(Eigen::Vector3d(-g.x(), -g.y(), 1.0), c);
+}
+
+bool RrtGroundDetector::continuesPatchAtCrest(const Plane& plane, const GroundDetection& out, double tol) const
+{
+	// A line of nodes (m_ransac's inliers, the nodes m_remaining[i]) next to
+	// an accepted extra patch (a ramp): the cable or the cable protector
+	// lying across it stands above the ramp's plane; the first rows of the
+	// landing past the ramp's top lie below the ramp's plane extended (a
+	// convex bend), and so does the crest of any hump. Those first rows are what the
+	// range of trust leaves of a landing: two rows of filled nodes (a minor
+	// std of 7.5 cm, a line) in ramp_8deg_0.7m seen by a D455 1 m up (range
+	// of trust 2.64 m), where the landing's cells were then judged against
+	// the ramp's plane extended, 1-3 cm above them: drops. A line is a
+	// crest if every one of its nodes within d_n of any accepted extra
+	// patch's nodes lies below that patch's plane, and two such pairs of
+	// neighbouring nodes meet as in joinsAcceptedPlane() (the line's plane
+	// changes side of the patch between them, or is within the noise band
+	// `tol` of it at the line's node, or within 2 tol at the patch's node).
+	const double link2 = m_params.expansion_distance * m_params.expansion_distance;
+	int joins = 0;
+	for (size_t i : m_ransac.inliers)
+	{
+		const GroundNode& p = out.nodes[m_remaining[i]];
+		for (const GroundNode& q : out.nodes)
+		{
+			if (q.plane_id < 1) continue;
+			const double dx = double(p.x) - q.x, dy = double(p.y) - q.y;
+			if (dx * dx + dy * dy > link2) continue;
+			const Plane& Q = out.planes[size_t(q.plane_id)];
+			if (double(p.z) >= Q.heightAt(p.x, p.y)) return false;  // on top of a patch: a cable, a kerb
+			const double atP = plane.heightAt(p.x, p.y) - Q.heightAt(p.x, p.y);
+			const double atQ = plane.heightAt(q.x, q.y) - Q.heightAt(q.x, q.y);
+			joins += (atP > 0) != (atQ > 0) || std::abs(atP) <= tol || std::abs(atQ) <= 2 * tol;
+		}
+	}
+	return joins >= 2;
 }
 
 void RrtGroundDetector::acceptPatch(const Plane& plane, size_t begin, size_t end, GroundDetection& out)

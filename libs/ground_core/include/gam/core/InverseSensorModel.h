@@ -327,6 +327,16 @@ class InverseSensorModel
 	const std::vector<float>& evidence() const { return m_evidence; }
 	/** Cells with evidence != 0.5 (indices into the frame grid). */
 	const std::vector<uint32_t>& evidenceCells() const { return m_evidenceCells; }
+	/** Whether a ramp or landing patch (planes[k], k >= 1) applies at frame
+	 * cell `cell` of a grid `nx` cells wide in the last compute() (within
+	 * plane_support_radius of its nodes, local_planes). */
+	bool patchApplies(uint32_t cell, int nx) const
+	{
+		if (m_support.empty() || nx <= 0) return false;
+		const int cx = int(cell % uint32_t(nx)), cy = int(cell / uint32_t(nx));
+		const size_t block = size_t(cy / m_blockCells) * size_t(m_bnx) + size_t(cx / m_blockCells);
+		return block < m_support.size() && m_support[block] != 0;
+	}
 	/** Class of each observed frame cell (None elsewhere). */
 	const std::vector<VoxelClass>& classes() const { return m_class; }
 

@@ -213,6 +213,20 @@ struct GroundSeedHint
 	}
 };
 
+/** The slope of a ground patch, measured twice: by the plane through its
+ * nodes' centres (`nodesGradient`, dz/dx and dz/dy; the centres' residual
+ * variance about it `residualVariance`, their 2D covariance `spread`) and by
+ * the nodes' own local planes (`localGradients`, one per node). Along each
+ * principal axis e of `spread` (eigenvalue lambda), the centres' plane has
+ * the variance residualVariance / (n lambda) (a least-squares slope over n
+ * points of that spread) and the mean of the local slopes its sample variance
+ * / n; the result is their inverse-variance weighted mean on each axis (a
+ * zero variance wins outright). Across a line of nodes lambda -> 0 and the
+ * local planes give the roll; along a patch its centres give the slope. */
+Eigen::Vector2d combinedPatchGradient(
+	const Eigen::Vector2d& nodesGradient, double residualVariance, const Eigen::Matrix2d& spread,
+	const std::vector<Eigen::Vector2d>& localGradients);
+
 /** Algorithm 1's search window (rrt_variant = paper): centred on the centroid
  * of the explored nodes, so it drifts toward them as the tree grows; its half
  * side along each axis is the nodes' largest offset from the centroid plus a
@@ -322,6 +336,16 @@ class RrtGroundDetector
 	 * an accepted plane between neighbouring nodes, not across a step of more
 	 * than `tol` (see fitPlanes). */
 	bool joinsAcceptedPlane(const Plane& plane, size_t begin, size_t end, const GroundDetection& out, double tol) const;
+	/** The plane through the centroid of m_ransac's inliers (indices into
+	 * `pts`, the nodes m_remaining[i]; `spread`: their 2D covariance) with
+	 * the combinedPatchGradient() of their centres and local planes. */
+	Plane patchFromNodesAndNormals(
+		const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const Eigen::Matrix2d& spread);
+	std::vector<Eigen::Vector2d> m_localGradients;
+	/** True if m_ransac's inliers, a line of nodes with plane `plane`, are
+	 * the crest of an accepted extra patch: below its plane wherever they
+	 * are within d_n of its nodes, and joining it (see fitPlanes). */
+	bool continuesPatchAtCrest(const Plane& plane, const GroundDetection& out, double tol) const;
 	/** Appends `plane` as a patch held by the nodes m_patchNodes[begin, end). */
 	void acceptPatch(const Plane& plane, size_t begin, size_t end, GroundDetection& out);
 	std::vector<int> m_cluster;
