@@ -48,17 +48,34 @@ double rampZ(double x, double y)
 constexpr double kCableX0 = 1.5, kCableX1 = 1.58, kCableH = 0.04;
 bool onCable(double x, double y) { return x >= kCableX0 && x < kCableX1 && std::abs(y) < kHalfWidth; }
 
+// The surface z(x, y) where `where` holds, 3 x 3 samples per 5 cm cell with
+// `noise` [m], into the 2.5D map as the pipeline puts them (3-sigma filter,
+// IDW).
+template <class Where, class Height>
+void sampleIntoGrid(ElevationGrid& grid, Where where, Height z, double noise, std::mt19937& rng)
+{
+	BinnedPoints b;
+	gamtest::sampleSurfaceIf(grid, where, z, 3, noise, rng, b);
+	gamtest::insertAll(grid, b);
+	grid.interpolateIdw(IdwParams{});
+}
+
+// RRT-GPD from a robot at the origin on the floor.
+GroundDetection detectFromOrigin(const ElevationGrid& grid)
+{
+	RrtGroundDetector det;
+	GroundDetection out;
+	det.detect(grid, {0, 0, 0}, out);
+	return out;
+}
+
 // 3 x 3 samples per 5 cm cell with 2 mm noise (a Kinect One 2-3 m away).
 void buildRampScene(ElevationGrid& grid, bool cable, uint32_t seed = 13, double noise = 0.002)
 {
 	std::mt19937 rng(seed);
-	BinnedPoints b;
-	gamtest::sampleSurfaceIf(
+	sampleIntoGrid(
 		grid, [](double x, double y) { return inRect(x, y, -1.0, 4.5, -2.5, 2.5); },
-		[cable](double x, double y) { return rampZ(x, y) + (cable && onCable(x, y) ? kCableH : 0.0); }, 3, noise, rng,
-		b);
-	gamtest::insertAll(grid, b);
-	grid.interpolateIdw(IdwParams{});
+		[cable](double x, double y) { return rampZ(x, y) + (cable && onCable(x, y) ? kCableH : 0.0); }, noise, rng);
 }
 
 // The camera: 1 m above the floor at the robot.
@@ -281,14 +298,9 @@ TEST(Ramps, TheFirstRowsOfALandingAreTheRampsCrestNotALine)
 	// the 60 cells got obstacle evidence against the ramp's plane extended.
 	ElevationGrid grid;
 	std::mt19937 rng(13);
-	BinnedPoints b;
-	gamtest::sampleSurfaceIf(
-		grid, [](double x, double y) { return inRect(x, y, -1.0, 2.45, -2.5, 2.5); }, rampZ, 3, 0.002, rng, b);
-	gamtest::insertAll(grid, b);
-	grid.interpolateIdw(IdwParams{});
-	RrtGroundDetector det;
-	GroundDetection out;
-	det.detect(grid, {0, 0, 0}, out);
+	sampleIntoGrid(
+		grid, [](double x, double y) { return inRect(x, y, -1.0, 2.45, -2.5, 2.5); }, rampZ, 0.002, rng);
+	const GroundDetection out = detectFromOrigin(grid);
 	ASSERT_TRUE(out.ok()) << out.describe();
 	std::cout << "ramp seen to 2.45 m: " << out.describe() << std::endl;
 	int landing = -1;
@@ -359,17 +371,12 @@ TEST(Ramps, GroundPlaneIsTheFloorUnderTheRobotEvenWhenTheLandingIsLarger)
 	g.ny = 100;
 	ElevationGrid grid(g);
 	std::mt19937 rng(5);
-	BinnedPoints b;
-	gamtest::sampleSurfaceIf(
+	sampleIntoGrid(
 		grid, [](double x, double y) { return inRect(x, y, -1.0, 5.0, -2.0, 2.0); },
 		[tan6](double x, double) { return x < 1.0   ? 0.0
 										  : x < 2.0 ? tan6 * (x - 1.0)
-													: tan6; }, 3, 0.002, rng, b);
-	gamtest::insertAll(grid, b);
-	grid.interpolateIdw(IdwParams{});
-	RrtGroundDetector det;
-	GroundDetection out;
-	det.detect(grid, {0, 0, 0}, out);
+													: tan6; }, 0.002, rng);
+	const GroundDetection out = detectFromOrigin(grid);
 	ASSERT_TRUE(out.ok()) << out.describe();
 	size_t floorNodes = 0, landingNodes = 0;
 	for (const GroundNode& n : out.nodes)
