@@ -295,8 +295,6 @@ class InverseSensorModel
    public:
 	/** Throws std::invalid_argument for parameters out of range. */
 	explicit InverseSensorModel(const IsmParams& p = {}) { setParams(p); }
-	/** Validates (throws std::invalid_argument), then keeps `p`: compute()
-	 * runs with parameters checked once, not on every frame. */
 	/** The camera that took the frame (focal length fx [px]): with a
 	 * correlated part in its noise (a stereo camera), the deep-sample test
 	 * also judges a cell from its own level. Default: none (independent
@@ -306,6 +304,8 @@ class InverseSensorModel
 		m_camera = noise;
 		m_fx = fx;
 	}
+	/** Validates (throws std::invalid_argument), then keeps `p`: compute()
+	 * runs with parameters checked once, not on every frame. */
 	void setParams(const IsmParams& p)
 	{
 		p.validate();
