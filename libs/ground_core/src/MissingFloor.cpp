@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace gam
 {
@@ -79,6 +80,56 @@ void meetGroundRow(
 {
 	const GroundRays g = rays;
 	for (int c = 0; c < cols; c++) g.meet(fy[c], fz[c], t[c], cx[c], cy[c]);
+}
+// The candidates of one image row (see compute(): its candidate()), as a
+// vector loop; returns how many.
+int candidateRow(
+	const GroundRays& rays, float thrDown, const float* __restrict fy, const float* __restrict fz,
+	const uint16_t* __restrict raw, int cols, bool statsRow, uint16_t rawInRange, uint8_t* __restrict isCandidate)
+{
+	const float n0 = rays.n0, n1 = rays.n1, n2 = rays.n2;
+	const uint8_t all = statsRow;
+	int candidates = 0;
+	for (int c = 0; c < cols; c++)
+	{
+		const bool meets = n0 + n1 * fy[c] + n2 * fz[c] < thrDown;
+		isCandidate[c] = uint8_t(meets & (all | (uint16_t(raw[c] - 1) >= rawInRange)));
+		candidates += isCandidate[c];
+	}
+	return candidates;
+}
+
+// The tests of judgeRay() in compute() that need no sample, for a whole
+// statistics row of a depth image (a vector loop): which pixels are judged
+// (ok), and each one's depth t and frame cell. Float bounds stand
+// for judgeRay's double tests exactly: a float t <= maxRange (double) when t
+// <= the largest float not above it; t >= min_range when t >= the smallest
+// float not below it; int(cx) < nx when cx < nx.
+struct JudgeBounds
+{
+	float thrDown, maxRange, minRange, nx, ny;
+	int32_t cellsPerRow;
+	double rangeBin;  ///< MissingFloorParams::range_bin
+};
+
+void judgeableRow(
+	const GroundRays& rays, const JudgeBounds& bounds, const float* __restrict fy, const float* __restrict fz, int cols,
+	float* __restrict t, uint8_t* __restrict ok, int32_t* __restrict cell)
+{
+	const GroundRays g = rays;
+	const JudgeBounds b = bounds;
+	for (int c = 0; c < cols; c++)
+	{
+		float tc, cx, cy;
+		g.meet(fy[c], fz[c], tc, cx, cy);
+		const bool judged = (g.n0 + g.n1 * fy[c] + g.n2 * fz[c] < b.thrDown) & (tc > 0.f) & (tc <= b.maxRange) &
+							(tc >= b.minRange) & (cx >= 0.f) & (cy >= 0.f) & (cx < b.nx) & (cy < b.ny);
+		// Zeros where not judged: no float-to-int conversion out of range.
+		const float x = judged ? cx : 0.f, y = judged ? cy : 0.f;
+		t[c] = tc;
+		ok[c] = uint8_t(judged);
+		cell[c] = int32_t(y) * b.cellsPerRow + int32_t(x);
+	}
 }
 }  // namespace
 
@@ -174,7 +225,23 @@ void MissingFloorDetector::compute(
 		m_rowT.resize(size_t(cols));
 		m_rowCx.resize(size_t(cols));
 		m_rowCy.resize(size_t(cols));
+		m_rowCell.resize(size_t(cols));
 	}
+	// judgeRay()'s double tests on a float depth t, as float bounds: t <=
+	// maxRange exactly when t <= the largest float not above maxRange; t >=
+	// min_range when t >= the smallest float not below it. A cell index
+	// int(cxf) < nx exactly when cxf < nx.
+	JudgeBounds bounds;
+	bounds.thrDown = thrDown;
+	bounds.maxRange = float(maxRange);
+	if (double(bounds.maxRange) > maxRange) bounds.maxRange = std::nextafter(bounds.maxRange, 0.f);
+	bounds.minRange = float(m_params.min_range);
+	if (double(bounds.minRange) < m_params.min_range)
+		bounds.minRange = std::nextafter(bounds.minRange, std::numeric_limits<float>::infinity());
+	bounds.nx = float(g.nx);
+	bounds.ny = float(g.ny);
+	bounds.cellsPerRow = g.nx;
+	bounds.rangeBin = m_params.range_bin;
 
 	for (int r = 0; r < img.rows; r += step)
 	{
@@ -248,12 +315,58 @@ void MissingFloorDetector::compute(
 			continue;
 		}
 		uint8_t* __restrict isCandidate = m_rowCandidate.data();
-		int candidates = 0;
-		for (int c = 0; c < cols; c++)
+		if (statsRow && img.is_depth)
 		{
-			isCandidate[c] = candidate(c);
-			candidates += isCandidate[c];
+			// A statistics row of a depth image: most of its pixels meet seen
+			// floor. The tests of judgeRay() that need no sample run for the
+			// whole row in one vector loop, then one predictable branch per
+			// pixel judges (the same decisions as judgeRay, in float
+			// bounds that are exact for the double tests: see fMaxRange).
+			judgeableRow(rays, bounds, fyRow, fzRow, cols, m_rowT.data(), isCandidate, m_rowCell.data());
+			const float* __restrict T = m_rowT.data();
+			const int32_t* __restrict cellOf = m_rowCell.data();
+			int before = 0;
+			size_t rowRays = 0, rowEmpty = 0;
+			for (int c = 0; c < cols; c++)
+			{
+				if (!isCandidate[c])
+				{
+					before = 0;
+					continue;
+				}
+				const uint16_t v = raw[c];
+				if (v == 0 && fxBaseline > 0 && missing::outsideSecondImager(c, double(T[c]), fxBaseline))
+				{
+					before = 0;
+					continue;
+				}
+				const bool empty =
+					v == 0 || (v > rawInRange && double(v) * units > double(T[c]) + m_params.beyond_margin);
+				rowRays++;
+				rowEmpty += empty;
+				const uint32_t cell = uint32_t(cellOf[c]);
+				const int now = grid.cell(cell).count > 0 ? (empty ? 2 : 1) : 0;
+				if (now)
+				{
+					const size_t bin = size_t(double(T[c]) / bounds.rangeBin);
+					m_binRays[bin]++;
+					m_binEmpty[bin] += empty;
+					if (before == 2)
+					{
+						pairsAfterEmpty++;
+						pairsBothEmpty += empty;
+					}
+				}
+				before = now;
+				if (!empty) continue;
+				if (m_empty[cell] == 0) m_touched.push_back(cell);
+				if (m_empty[cell] < 65535) m_empty[cell]++;
+			}
+			stats.rays += rowRays;
+			stats.empty_rays += rowEmpty;
+			continue;
 		}
+		const int candidates = candidateRow(rays, thrDown, fyRow, fzRow, raw, cols, statsRow, rawInRange, isCandidate);
 		// Where the rays meet the ground: in a vector loop for the whole row
 		// where candidates are many (a statistics row, a row of dropouts),
 		// else one candidate at a time.

@@ -182,6 +182,8 @@ class MissingFloorDetector
 	// there (see compute()).
 	std::vector<uint8_t> m_rowCandidate;
 	std::vector<float> m_rowT, m_rowCx, m_rowCy;
+	// A statistics row: the frame cell of each pixel that is judged.
+	std::vector<int32_t> m_rowCell;
 };
 
 }  // namespace gam
