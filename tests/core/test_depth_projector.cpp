@@ -145,6 +145,51 @@ TEST(DepthProjector, RayLutFollowsMrptConvention)
 	EXPECT_EQ(out.size(), 0u);  // an all-zero image bins nothing
 }
 
+TEST(DepthProjector, RowRayBoundsAreTheRowsExtremeRayFactors)
+{
+	// camera(): 64x48, cx = 31.5, cy = 23.5, fx = fy = 50. Without distortion
+	// a row's y/x factor (31.5 - c) / 50 runs from 31.5 / 50 = 0.63 (c = 0)
+	// down to -31.5 / 50 = -0.63 (c = 63); its z/x factor (23.5 - r) / 50 is
+	// the same along the row: 0.47 on row 0, 0.01 on row 23, -0.47 on row 47.
+	DepthProjector proj;
+	ElevationGrid grid;
+	BinnedPoints out;
+	Image img;
+	proj.project(img.view(), camera(), RigidTransform{}, ProjectionFilter{}, grid, out);
+	for (const auto& [r, z] : {std::pair{0, 0.47}, {23, 0.01}, {47, -0.47}})
+	{
+		const DepthProjector::RayBounds& b = proj.rowRayBounds(r);
+		EXPECT_NEAR(b.y_min, -0.63, 1e-6) << r;
+		EXPECT_NEAR(b.y_max, 0.63, 1e-6) << r;
+		EXPECT_NEAR(b.z_min, z, 1e-6) << r;
+		EXPECT_NEAR(b.z_max, z, 1e-6) << r;
+	}
+	// With distortion the factors bend along a row: the bounds are still the
+	// smallest and largest of the row's table entries.
+	PinholeIntrinsics K = camera();
+	K.k1 = 0.12;
+	K.p1 = 0.001;
+	proj.project(img.view(), K, RigidTransform{}, ProjectionFilter{}, grid, out);
+	for (int r = 0; r < H; r += 5)
+	{
+		float yLo = 1e9f, yHi = -1e9f, zLo = 1e9f, zHi = -1e9f;
+		for (int c = 0; c < W; c++)
+		{
+			const Eigen::Vector2f k = proj.rayFactor(r, c);
+			yLo = std::min(yLo, k.x());
+			yHi = std::max(yHi, k.x());
+			zLo = std::min(zLo, k.y());
+			zHi = std::max(zHi, k.y());
+		}
+		const DepthProjector::RayBounds& b = proj.rowRayBounds(r);
+		EXPECT_EQ(b.y_min, yLo) << r;
+		EXPECT_EQ(b.y_max, yHi) << r;
+		EXPECT_EQ(b.z_min, zLo) << r;
+		EXPECT_EQ(b.z_max, zHi) << r;
+		EXPECT_LT(b.z_min, b.z_max) << r;  // k1 bends the row's z/x factor
+	}
+}
+
 TEST(DepthProjector, WallAtThreeMetresLandsInItsColumn)
 {
 	// Sensor at (0, 0, 0.5) looking along +X; wall x = 3.02 (column 160 of a

@@ -78,6 +78,17 @@ void DepthProjector::updateLut(const PinholeIntrinsics& K)
 			m_rayInvNorm[i] = 1.0f / std::sqrt(1.0f + ky * ky + kz * kz);
 		}
 	}
+	m_rowRayBounds.resize(size_t(K.height));
+	for (int r = 0; r < K.height; r++)
+	{
+		const float* y = rayYRow(r);
+		const float* z = rayZRow(r);
+		RayBounds& b = m_rowRayBounds[size_t(r)];
+		b.y_min = *std::min_element(y, y + K.width);
+		b.y_max = *std::max_element(y, y + K.width);
+		b.z_min = *std::min_element(z, z + K.width);
+		b.z_max = *std::max_element(z, z + K.width);
+	}
 }
 
 void DepthProjector::updateDecimatedLut(int dec)

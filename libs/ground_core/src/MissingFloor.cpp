@@ -99,6 +99,19 @@ int candidateRow(
 	return candidates;
 }
 
+// The pixels of one image row that returned nothing within the range (raw 0,
+// or beyond rawInRange), as a vector loop; returns how many.
+int emptyRow(const uint16_t* __restrict raw, int cols, uint16_t rawInRange, uint8_t* __restrict isEmpty)
+{
+	int empty = 0;
+	for (int c = 0; c < cols; c++)
+	{
+		isEmpty[c] = uint8_t(uint16_t(raw[c] - 1) >= rawInRange);
+		empty += isEmpty[c];
+	}
+	return empty;
+}
+
 // The tests of judgeRay() in compute() that need no sample, for a whole
 // statistics row of a depth image (a vector loop): which pixels are judged
 // (ok), and each one's depth t and frame cell. Float bounds stand
@@ -243,6 +256,27 @@ void MissingFloorDetector::compute(
 	bounds.cellsPerRow = g.nx;
 	bounds.rangeBin = m_params.range_bin;
 
+	// Whether every ray of a row meets the ground within the range (down <
+	// thrDown), none does, or some do: down = n0 + n1 fy + n2 fz over the
+	// row's box of (fy, fz), in double, with a margin of 1e-5 of the terms'
+	// size (the float sum of three products is off by a few 1e-7 of it).
+	enum class RowRays
+	{
+		Meet,
+		None,
+		Some
+	};
+	const auto rowRays = [&](const DepthProjector::RayBounds& b) {
+		const double a1 = double(n1) * b.y_min, b1 = double(n1) * b.y_max;
+		const double a2 = double(n2) * b.z_min, b2 = double(n2) * b.z_max;
+		const double lo = double(n0) + std::min(a1, b1) + std::min(a2, b2);
+		const double hi = double(n0) + std::max(a1, b1) + std::max(a2, b2);
+		const double margin =
+			1e-5 * (std::abs(double(n0)) + std::max(std::abs(a1), std::abs(b1)) + std::max(std::abs(a2), std::abs(b2)));
+		if (hi + margin < double(thrDown)) return RowRays::Meet;
+		if (lo - margin >= double(thrDown)) return RowRays::None;
+		return RowRays::Some;
+	};
 	for (int r = 0; r < img.rows; r += step)
 	{
 		const float* __restrict fyRow = projector.rayYRow(r);
@@ -250,6 +284,8 @@ void MissingFloorDetector::compute(
 		const uint16_t* __restrict raw = img.data + size_t(r) * img.stride;
 		int prev = 0;  // previous pixel of the row: 0 none, 1 seen floor, 2 empty on seen floor
 		const bool statsRow = (r / step) % m_params.stats_row_step == 0;
+		const RowRays rowAll = step == 1 ? rowRays(projector.rowRayBounds(r)) : RowRays::Some;
+		if (rowAll == RowRays::None) continue;  // no ray meets the ground within the range: no candidate
 		// One pixel whose ray may meet the ground within the range, at depth
 		// tf in cell (cxf, cyf).
 		const auto judgeRay = [&](int c, float tf, float cxf, float cyf) {
@@ -366,7 +402,14 @@ void MissingFloorDetector::compute(
 			stats.empty_rays += rowEmpty;
 			continue;
 		}
-		const int candidates = candidateRow(rays, thrDown, fyRow, fzRow, raw, cols, statsRow, rawInRange, isCandidate);
+		// Where every ray of the row meets the ground within the range
+		// (rowRays), outside the statistics rows only its empty pixels are
+		// candidates: found from the depths alone, without reading the ray
+		// table (8 bytes a pixel).
+		const int candidates =
+			rowAll == RowRays::Meet && !statsRow
+				? emptyRow(raw, cols, rawInRange, isCandidate)
+				: candidateRow(rays, thrDown, fyRow, fzRow, raw, cols, statsRow, rawInRange, isCandidate);
 		// Where the rays meet the ground: in a vector loop for the whole row
 		// where candidates are many (a statistics row, a row of dropouts),
 		// else one candidate at a time.

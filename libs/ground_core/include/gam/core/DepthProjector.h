@@ -113,6 +113,15 @@ class DepthProjector
 	const float* rayYRow(int row) const { return m_rayY.data() + size_t(row) * size_t(m_lutK.width); }
 	const float* rayZRow(int row) const { return m_rayZ.data() + size_t(row) * size_t(m_lutK.width); }
 
+	/** The range of a row's ray factors (see rowRayBounds). */
+	struct RayBounds
+	{
+		float y_min, y_max, z_min, z_max;
+	};
+	/** The smallest and largest ray factors of one row of the table: lets a
+	 * caller tell a whole row's rays apart from a plane without reading them. */
+	const RayBounds& rowRayBounds(int row) const { return m_rowRayBounds[size_t(row)]; }
+
 	/** A flying pixel: along its row or its column (neighbours `step` pixels
 	 * apart), its depth d lies strictly between its two neighbours a and b,
 	 * more than `tol` from each, and it continues neither side's surface: on
@@ -143,6 +152,7 @@ class DepthProjector
 	// Ray table, one entry per pixel, as separate arrays so the row loop vectorizes.
 	std::vector<float> m_rayY, m_rayZ;  // y/x and z/x
 	std::vector<float> m_rayInvNorm;    // 1 / |(1, y/x, z/x)|, for range images
+	std::vector<RayBounds> m_rowRayBounds;
 	// With decimation n > 1: the ray table of every n-th row and column
 	// (contiguous, so that the row loop runs on it unchanged) and one row's
 	// used pixels.
