@@ -41,7 +41,8 @@ struct Result
 /** Runs the projector, the 2.5D map, hand-made classes (every cell with
  * samples is Ground) and the detector on `scene`. The grid is 20 x 20 cells
  * from (-0.5, -0.5): the image sees only its middle 10 x 10 cells. */
-void run(const Scene& scene, Result& out, MissingFloorParams p = {}, double baseline = 0)
+void run(
+	const Scene& scene, Result& out, MissingFloorParams p = {}, double baseline = 0, const PatchSupport& patches = {})
 {
 	PinholeIntrinsics K;
 	K.width = K.height = kSize;
@@ -84,7 +85,7 @@ void run(const Scene& scene, Result& out, MissingFloorParams p = {}, double base
 	p.stats_row_step = 1;  // every row, for the hand counts below
 	out.det.setParams(p);
 	out.det.setSecondImagerBaseline(baseline);
-	out.det.compute(frame, proj, 1, 4.5, floor, out.grid, classes, out.stats);
+	out.det.compute(frame, proj, 1, 4.5, floor, out.grid, classes, out.stats, patches);
 }
 
 uint32_t cellOf(int ix, int iy) { return uint32_t(iy * 20 + ix); }
@@ -143,6 +144,41 @@ TEST(MissingFloor, DarkHoleInSeenFloorIsMarked)
 	// The floor around it is not missing.
 	EXPECT_FALSE(res.det.isMissing(cellOf(11, 8)));
 	EXPECT_FALSE(res.det.isMissing(cellOf(9, 9)));
+}
+
+TEST(MissingFloor, NoMissingFloorWhereARampPatchApplies)
+{
+	// The hole of DarkHoleInSeenFloorIsMarked (cells x 9-10, y 7-8), with a
+	// ramp patch applying on blocks of 4 x 4 cells: block (bx, by) = (x / 4,
+	// y / 4) holds cells x 8-11, y 4-7 for (2, 1), index by * 5 + bx = 7 in
+	// a table 5 blocks wide. It covers the hole's y = 7 cells; the y = 8
+	// cells lie in block (2, 2), which no patch covers.
+	Scene s;
+	for (int r = 16; r < 24; r++)
+		for (int c = 24; c < 32; c++) s.at(r, c) = 0;
+	std::vector<uint8_t> blocks(25, 0);
+	blocks[7] = 1;
+	const PatchSupport patches{blocks.data(), blocks.size(), 4, 5, 20};
+	ASSERT_TRUE(patches.applies(cellOf(9, 7)));
+	ASSERT_FALSE(patches.applies(cellOf(9, 8)));
+	Result res;
+	MissingFloorParams p;
+	p.block_range = 0.1;
+	run(s, res, p, 0, patches);
+	// Still one bordered region of 4 candidate cells; the 2 under the patch
+	// are left out, the other 2 (0.079 m from the sensor) are missing and block.
+	EXPECT_EQ(res.stats.regions, 1u);
+	EXPECT_EQ(res.stats.under_patches, 2u);
+	EXPECT_EQ(res.stats.cells, 2u);
+	EXPECT_EQ(res.stats.blocking, 2u);
+	for (int ix : {9, 10})
+	{
+		EXPECT_FALSE(res.det.isMissing(cellOf(ix, 7))) << ix;
+		EXPECT_FALSE(res.det.isBlocking(cellOf(ix, 7))) << ix;
+		EXPECT_TRUE(res.det.isMissing(cellOf(ix, 8))) << ix;
+		EXPECT_TRUE(res.det.isBlocking(cellOf(ix, 8))) << ix;
+	}
+	for (uint32_t c : res.det.cells()) EXPECT_EQ(int(c / 20), 8);
 }
 
 TEST(MissingFloor, OutsideTheFieldOfViewIsNotMarked)

@@ -192,7 +192,7 @@ const FrameResult& GroundAwarePipeline::process(
 		m_missing.setSecondImagerBaseline(noise.baseline);
 		m_missing.compute(
 			frame, m_projector, m_params.projection.decimation, range, m_result.detection.plane(), m_grid,
-			m_ism.classes(), m_result.missing);
+			m_ism.classes(), m_result.missing, m_ism.patchSupport(m_grid.geometry().nx));
 	}
 	const auto t5 = clk::now();
 

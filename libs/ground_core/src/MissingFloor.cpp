@@ -148,7 +148,8 @@ void judgeableRow(
 
 void MissingFloorDetector::compute(
 	const SensorFrame& frame, const DepthProjector& projector, int decimation, double maxRange, const Plane& ground,
-	const ElevationGrid& grid, const std::vector<VoxelClass>& classes, MissingFloorStats& stats)
+	const ElevationGrid& grid, const std::vector<VoxelClass>& classes, MissingFloorStats& stats,
+	const PatchSupport& patches)
 {
 	clear();
 	stats = MissingFloorStats{};
@@ -534,6 +535,12 @@ void MissingFloorDetector::compute(
 		stats.regions++;
 		for (uint32_t c : m_region)
 		{
+			if (patches.applies(c))
+			{
+				// Judged against the wrong surface (see compute()'s comment).
+				stats.under_patches++;
+				continue;
+			}
 			m_mark[c] = kMissing;
 			m_cells.push_back(c);
 			if (dist2(int(c % uint32_t(g.nx)), int(c / uint32_t(g.nx))) <= block2)

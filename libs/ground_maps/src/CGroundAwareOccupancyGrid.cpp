@@ -764,16 +764,11 @@ void CGroundAwareOccupancyGrid::applyEvidence(const gam::GroundAwarePipeline& pi
 		cellType& cell = m_map[size_t(wx) + size_t(wy) * getSizeX()];
 		cell = cellType(std::clamp(int(cell) + l, int(OCCGRID_CELLTYPE_MIN), int(OCCGRID_CELLTYPE_MAX)));
 	};
-	// Missing floor is judged against the ground plane: where a ramp or
-	// landing patch applies, that plane does not say where the rays meet the
-	// surface nor at which incidence, and a ramp's far, down-going side
-	// returns nothing at grazing incidence (the Femto's angled 8 deg ramp:
-	// 215 of the 250 pieces of evidence on its occupied cells at 0cf58c5).
-	// Those cells are not judged (issue #27).
-	const auto judged = [&](uint32_t c) { return !ism.patchApplies(c, g.nx); };
-	for (uint32_t c : cells) update(c, missing.isBlocking(c) && judged(c) ? gam::ism::combine(ev[c], pMissing) : ev[c]);
+	// (No missing floor where a ramp or landing patch applies: the detector
+	// leaves those cells out, MissingFloorDetector::compute.)
+	for (uint32_t c : cells) update(c, missing.isBlocking(c) ? gam::ism::combine(ev[c], pMissing) : ev[c]);
 	for (uint32_t c : missing.blockingCells())
-		if (ev[c] == 0.5f && judged(c)) update(c, pMissing);
+		if (ev[c] == 0.5f) update(c, pMissing);
 
 	// The missing-floor layer: this frame's judgement replaces the old one;
 	// floor seen clears a cell.
@@ -787,8 +782,7 @@ void CGroundAwareOccupancyGrid::applyEvidence(const gam::GroundAwarePipeline& pi
 	};
 	for (uint32_t c : cells)
 		if (c < cls.size() && cls[c] == gam::VoxelClass::Ground) setLayer(c, 1.0f);
-	for (uint32_t c : missingCells)
-		if (judged(c)) setLayer(c, 0.0f);
+	for (uint32_t c : missingCells) setLayer(c, 0.0f);
 	m_is_empty = false;
 	m_likelihoodCacheOutDated = true;
 }

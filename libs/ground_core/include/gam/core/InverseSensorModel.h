@@ -290,6 +290,26 @@ struct IsmStats
 	bool applied = false;              ///< false when there was no ground plane
 };
 
+/** Where ramp or landing patches (planes[k], k >= 1) applied in an
+ * InverseSensorModel::compute(), per block of frame cells: a view of the
+ * model's own table (InverseSensorModel::patchSupport()). Empty: nowhere. */
+struct PatchSupport
+{
+	const uint8_t* blocks = nullptr;
+	size_t count = 0;     ///< blocks in the table
+	int block_cells = 1;  ///< a block is block_cells x block_cells frame cells
+	int blocks_x = 0;     ///< blocks per row of the table
+	int nx = 0;           ///< frame grid width [cells]
+
+	bool applies(uint32_t cell) const
+	{
+		if (!count || nx <= 0 || block_cells <= 0) return false;
+		const int cx = int(cell % uint32_t(nx)), cy = int(cell / uint32_t(nx));
+		const size_t block = size_t(cy / block_cells) * size_t(blocks_x) + size_t(cx / block_cells);
+		return block < count && blocks[block] != 0;
+	}
+};
+
 class InverseSensorModel
 {
    public:
@@ -330,13 +350,9 @@ class InverseSensorModel
 	/** Whether a ramp or landing patch (planes[k], k >= 1) applies at frame
 	 * cell `cell` of a grid `nx` cells wide in the last compute() (within
 	 * plane_support_radius of its nodes, local_planes). */
-	bool patchApplies(uint32_t cell, int nx) const
-	{
-		if (m_support.empty() || nx <= 0) return false;
-		const int cx = int(cell % uint32_t(nx)), cy = int(cell / uint32_t(nx));
-		const size_t block = size_t(cy / m_blockCells) * size_t(m_bnx) + size_t(cx / m_blockCells);
-		return block < m_support.size() && m_support[block] != 0;
-	}
+	bool patchApplies(uint32_t cell, int nx) const { return patchSupport(nx).applies(cell); }
+	/** The same for every cell, as a view (valid until the next compute()). */
+	PatchSupport patchSupport(int nx) const { return {m_support.data(), m_support.size(), m_blockCells, m_bnx, nx}; }
 	/** Class of each observed frame cell (None elsewhere). */
 	const std::vector<VoxelClass>& classes() const { return m_class; }
 

@@ -93,14 +93,15 @@ struct MissingFloorParams
 
 struct MissingFloorStats
 {
-	size_t rays = 0;        ///< pixels whose ray meets the ground within range
-	size_t empty_rays = 0;  ///< of those, no return (or one far below the floor)
-	size_t candidates = 0;  ///< cells with no sample, enough empty rays, unlikely as dropout
-	size_t cells = 0;       ///< missing-floor cells (in regions bordering floor)
-	size_t regions = 0;     ///< their connected regions
-	size_t unbordered = 0;  ///< candidate regions dropped: no seen floor both before and beyond them
-	size_t blocking = 0;    ///< missing cells within block_range
-	bool applied = false;   ///< the stage ran on this frame
+	size_t rays = 0;           ///< pixels whose ray meets the ground within range
+	size_t empty_rays = 0;     ///< of those, no return (or one far below the floor)
+	size_t candidates = 0;     ///< cells with no sample, enough empty rays, unlikely as dropout
+	size_t cells = 0;          ///< missing-floor cells (in regions bordering floor)
+	size_t regions = 0;        ///< their connected regions
+	size_t unbordered = 0;     ///< candidate regions dropped: no seen floor both before and beyond them
+	size_t blocking = 0;       ///< missing cells within block_range
+	size_t under_patches = 0;  ///< cells of bordered regions left out: a ramp or landing patch applies there
+	bool applied = false;      ///< the stage ran on this frame
 };
 
 namespace missing
@@ -143,10 +144,15 @@ class MissingFloorDetector
 	 * table of frame.intrinsics (its project() ran on this frame);
 	 * `decimation` is the projection's; `maxRange` the range within which the
 	 * sensor returns floor (depth for depth images, range along the ray for
-	 * range images) [m]. */
+	 * range images) [m]. Missing floor is judged against the ground plane:
+	 * where a ramp or landing patch applies (`patches`), that plane says
+	 * neither where the rays meet the surface nor at which incidence (a
+	 * ramp's far, down-going side returns nothing at grazing incidence), so
+	 * no cell there is missing floor (stats.under_patches counts them). */
 	void compute(
 		const SensorFrame& frame, const DepthProjector& projector, int decimation, double maxRange, const Plane& ground,
-		const ElevationGrid& grid, const std::vector<VoxelClass>& classes, MissingFloorStats& stats);
+		const ElevationGrid& grid, const std::vector<VoxelClass>& classes, MissingFloorStats& stats,
+		const PatchSupport& patches = {});
 	/** Forgets the last frame's cells. */
 	void clear();
 
