@@ -968,6 +968,20 @@ Plane RrtGroundDetector::patchFromNodesAndNormals(
 	return Plane::fromNormalAndPoint(Eigen::Vector3d(-g.x(), -g.y(), 1.0), c);
 }
 
+namespace
+{
+// Whether `plane` and node q's plane Q meet between nodes p and q (a tree
+// step apart): plane's height over Q changes sign from p to q, or is within
+// `pBand` of it at p, or within `qBand` at q.
+bool planesMeetBetween(
+	const Plane& plane, const Plane& Q, const GroundNode& p, const GroundNode& q, double pBand, double qBand)
+{
+	const double atP = plane.heightAt(p.x, p.y) - Q.heightAt(p.x, p.y);
+	const double atQ = plane.heightAt(q.x, q.y) - Q.heightAt(q.x, q.y);
+	return (atP > 0) != (atQ > 0) || std::abs(atP) <= pBand || std::abs(atQ) <= qBand;
+}
+}  // namespace
+
 bool RrtGroundDetector::continuesPatchAtCrest(const Plane& plane, const GroundDetection& out, double tol) const
 {
 	// A line of nodes (m_ransac's inliers, the nodes m_remaining[i]) next to
@@ -996,9 +1010,7 @@ bool RrtGroundDetector::continuesPatchAtCrest(const Plane& plane, const GroundDe
 			if (dx * dx + dy * dy > link2) continue;
 			const Plane& Q = out.planes[size_t(q.plane_id)];
 			if (double(p.z) >= Q.heightAt(p.x, p.y)) return false;  // on top of a patch: a cable, a kerb
-			const double atP = plane.heightAt(p.x, p.y) - Q.heightAt(p.x, p.y);
-			const double atQ = plane.heightAt(q.x, q.y) - Q.heightAt(q.x, q.y);
-			joins += (atP > 0) != (atQ > 0) || std::abs(atP) <= tol || std::abs(atQ) <= 2 * tol;
+			joins += planesMeetBetween(plane, Q, p, q, tol, 2 * tol);
 		}
 	}
 	return joins >= 2;
@@ -1034,10 +1046,8 @@ bool RrtGroundDetector::joinsAcceptedPlane(
 			const double dx = double(p.x) - q.x, dy = double(p.y) - q.y;
 			if (dx * dx + dy * dy > link2) continue;
 			const Plane& Q = out.planes[size_t(q.plane_id)];
-			const double atP = plane.heightAt(p.x, p.y) - Q.heightAt(p.x, p.y);
-			const double atQ = plane.heightAt(q.x, q.y) - Q.heightAt(q.x, q.y);
 			const double qBand = tol + (q.plane_id == 0 ? m_params.ransac_inlier_distance : tol);
-			if (((atP > 0) != (atQ > 0) || std::abs(atP) <= tol || std::abs(atQ) <= qBand) && ++joins >= 2) return true;
+			if (planesMeetBetween(plane, Q, p, q, tol, qBand) && ++joins >= 2) return true;
 		}
 	}
 	return false;
