@@ -285,7 +285,8 @@ void MissingFloorDetector::compute(
 		const uint16_t* __restrict raw = img.data + size_t(r) * img.stride;
 		int prev = 0;  // previous pixel of the row: 0 none, 1 seen floor, 2 empty on seen floor
 		const bool statsRow = (r / step) % m_params.stats_row_step == 0;
-		const RowRays rowAll = step == 1 ? rowRays(projector.rowRayBounds(r)) : RowRays::Some;
+		// (The bounds hold for every n-th pixel of a decimated row too.)
+		const RowRays rowAll = rowRays(projector.rowRayBounds(r));
 		if (rowAll == RowRays::None) continue;  // no ray meets the ground within the range: no candidate
 		// One pixel whose ray may meet the ground within the range, at depth
 		// tf in cell (cxf, cyf).
@@ -344,8 +345,11 @@ void MissingFloorDetector::compute(
 		};
 		if (step != 1)
 		{
+			// Where every ray meets the ground, candidate(c) is statsRow or an
+			// empty pixel: no ray to read.
+			const bool allMeet = rowAll == RowRays::Meet;
 			for (int c = 0; c < cols; c += step)
-				if (candidate(c))
+				if (allMeet ? statsRow || uint16_t(raw[c] - 1) >= rawInRange : bool(candidate(c)))
 					judgeOne(c);
 				else
 					prev = 0;
