@@ -384,3 +384,102 @@ TEST(MissingFloor, TheStereoInvalidBandIsNoEvidence)
 	EXPECT_TRUE(hole.det.isMissing(cellOf(9, 7)));
 	EXPECT_TRUE(hole.det.isMissing(cellOf(10, 8)));
 }
+
+TEST(MissingFloor, EmptyRaysDoNotDependOnTheStatisticsRows)
+{
+	// A camera 1 m up, pitched 10 deg down and rolled 5 deg, fx = fy = 40 on
+	// 64 x 48 pixels (+-31 deg vertically): the top rows look above the
+	// horizon, the rows below it meet the floor beyond the 4.5 m range (their
+	// rays must not count) and, with the roll, some rows do both. Every pixel
+	// returns the floor (depth = x in the sensor frame: t for the ray (1, y/x,
+	// z/x)), nothing above the horizon or beyond 6 m. The statistics rows are
+	// judged one way (every pixel), the other rows another (only empty pixels,
+	// the ray table read only where a row's rays are not all on one side of
+	// the ground): the empty rays per cell must not depend on which rows are
+	// statistics rows.
+	constexpr int W = 64, H = 48;
+	PinholeIntrinsics K;
+	K.width = W;
+	K.height = H;
+	K.fx = K.fy = 40;
+	K.cx = 31.5;
+	K.cy = 23.5;
+	const Eigen::Matrix3d R = (Eigen::AngleAxisd(10.0 * M_PI / 180, Eigen::Vector3d::UnitY()) *
+							   Eigen::AngleAxisd(5.0 * M_PI / 180, Eigen::Vector3d::UnitX()))
+								  .toRotationMatrix();
+	std::vector<uint16_t> depth(size_t(W * H), 0);
+	int expectedEmpty = 0;
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+		{
+			const Eigen::Vector3d d = R * Eigen::Vector3d(1, (K.cx - c) / K.fx, (K.cy - r) / K.fy);
+			if (!(d.z() < 0)) continue;  // above the horizon: no return
+			const double t = 1.0 / -d.z();
+			if (t > 6.0) continue;
+			depth[size_t(r * W + c)] = uint16_t(std::lround(t * 1000));
+			// Dark pixels well inside [0.5, 4.5] m: a block and every 7th pixel
+			// of some rows (dropouts) at 1 - 3 m, and every 5th pixel at 3.6 -
+			// 4.3 m, where the rolled rows also hold floor beyond the range.
+			const bool block = r >= 34 && r < 40 && c >= 20 && c < 30;
+			const bool dropout = r >= 30 && r < 44 && c % 7 == 3;
+			const bool far = c % 5 == 1 && t > 3.6 && t < 4.3;
+			if (((block || dropout) && t > 1.0 && t < 3.0) || far)
+			{
+				depth[size_t(r * W + c)] = 0;
+				expectedEmpty++;
+			}
+		}
+	ASSERT_GT(expectedEmpty, 60);
+
+	RangeImageView img;
+	img.data = depth.data();
+	img.rows = H;
+	img.cols = W;
+	img.stride = W;
+	img.units = 0.001f;
+	img.is_depth = true;
+	SensorFrame frame;
+	frame.has_image = true;
+	frame.image = img;
+	frame.intrinsics = K;
+	frame.sensor_to_map.R = R.cast<float>();
+	frame.sensor_to_map.t = Eigen::Vector3f(0, 0, 1);
+	frame.sensor_position = Eigen::Vector3d(0, 0, 1);
+	frame.max_range = 4.5f;
+	GridGeometry g;
+	g.x_min = 0;  // the floor within 4.5 m, |y| < 3.6 m at the view's edges
+	g.y_min = -4;
+	g.resolution = 0.05;
+	g.nx = 100;
+	g.ny = 160;
+	ElevationGrid grid;
+	grid.resize(g);
+	BinnedPoints bins;
+	DepthProjector proj;
+	ProjectionFilter f;
+	f.max_range = 4.5f;
+	proj.project(img, K, frame.sensor_to_map, f, grid, bins);
+	grid.insert(bins, OutlierFilterParams{});
+	std::vector<VoxelClass> classes(g.cellCount(), VoxelClass::None);
+	for (size_t i = 0; i < g.cellCount(); i++)
+		if (grid.cell(i).count) classes[i] = VoxelClass::Ground;
+
+	std::vector<std::vector<uint16_t>> emptyPerCell;
+	for (int statsRows : {1, 3, 4})
+	{
+		MissingFloorParams p;
+		p.stats_row_step = statsRows;
+		MissingFloorDetector det(p);
+		MissingFloorStats stats;
+		det.compute(frame, proj, 1, 4.5, Plane{}, grid, classes, stats);
+		// Every dark pixel meets the floor within the range: each is one empty
+		// ray; the empty pixels above the horizon and the floor beyond 4.5 m
+		// are none.
+		EXPECT_EQ(stats.empty_rays, size_t(expectedEmpty)) << statsRows;
+		std::vector<uint16_t> perCell(g.cellCount());
+		for (size_t i = 0; i < perCell.size(); i++) perCell[i] = det.emptyRays(uint32_t(i));
+		emptyPerCell.push_back(perCell);
+	}
+	EXPECT_EQ(emptyPerCell[0], emptyPerCell[1]);
+	EXPECT_EQ(emptyPerCell[0], emptyPerCell[2]);
+}
