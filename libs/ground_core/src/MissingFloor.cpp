@@ -81,6 +81,7 @@ void meetGroundRow(
 	const GroundRays g = rays;
 	for (int c = 0; c < cols; c++) g.meet(fy[c], fz[c], t[c], cx[c], cy[c]);
 }
+
 // The candidates of one image row (see compute(): its candidate()), as a
 // vector loop; returns how many.
 int candidateRow(
@@ -241,10 +242,7 @@ void MissingFloorDetector::compute(
 		m_rowCy.resize(size_t(cols));
 		m_rowCell.resize(size_t(cols));
 	}
-	// judgeRay()'s double tests on a float depth t, as float bounds: t <=
-	// maxRange exactly when t <= the largest float not above maxRange; t >=
-	// min_range when t >= the smallest float not below it. A cell index
-	// int(cxf) < nx exactly when cxf < nx.
+	// judgeRay()'s double tests as float bounds (see JudgeBounds).
 	JudgeBounds bounds;
 	bounds.thrDown = thrDown;
 	bounds.maxRange = float(maxRange);
@@ -289,7 +287,8 @@ void MissingFloorDetector::compute(
 		const RowRays rowAll = rowRays(projector.rowRayBounds(r));
 		if (rowAll == RowRays::None) continue;  // no ray meets the ground within the range: no candidate
 		// One pixel whose ray may meet the ground within the range, at depth
-		// tf in cell (cxf, cyf).
+		// tf in cell (cxf, cyf). (The statistics rows of depth images take
+		// the same decisions in their own loop below.)
 		const auto judgeRay = [&](int c, float tf, float cxf, float cyf) {
 			const int before = prev;
 			prev = 0;
@@ -361,13 +360,13 @@ void MissingFloorDetector::compute(
 			// A statistics row of a depth image: most of its pixels meet seen
 			// floor. The tests of judgeRay() that need no sample run for the
 			// whole row in one vector loop, then one predictable branch per
-			// pixel judges (the same decisions as judgeRay, in float
-			// bounds that are exact for the double tests: see fMaxRange).
+			// pixel judges: the same decisions as judgeRay() (a change to
+			// one is a change to both; the maps were byte-identical).
 			judgeableRow(rays, bounds, fyRow, fzRow, cols, m_rowT.data(), isCandidate, m_rowCell.data());
 			const float* __restrict T = m_rowT.data();
 			const int32_t* __restrict cellOf = m_rowCell.data();
 			int before = 0;
-			size_t rowRays = 0, rowEmpty = 0;
+			size_t rowRayCount = 0, rowEmpty = 0;
 			for (int c = 0; c < cols; c++)
 			{
 				if (!isCandidate[c])
@@ -383,7 +382,7 @@ void MissingFloorDetector::compute(
 				}
 				const bool empty =
 					v == 0 || (v > rawInRange && double(v) * units > double(T[c]) + m_params.beyond_margin);
-				rowRays++;
+				rowRayCount++;
 				rowEmpty += empty;
 				const uint32_t cell = uint32_t(cellOf[c]);
 				const int now = grid.cell(cell).count > 0 ? (empty ? 2 : 1) : 0;
@@ -403,7 +402,7 @@ void MissingFloorDetector::compute(
 				if (m_empty[cell] == 0) m_touched.push_back(cell);
 				if (m_empty[cell] < 65535) m_empty[cell]++;
 			}
-			stats.rays += rowRays;
+			stats.rays += rowRayCount;
 			stats.empty_rays += rowEmpty;
 			continue;
 		}
