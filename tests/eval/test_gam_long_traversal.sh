@@ -9,7 +9,15 @@ set -euo pipefail
 src=$1 build=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+# A failure shows the report and the tool's last lines (it was seen to fail
+# now and then under a loaded ctest -j2, cause unknown; this makes the next
+# one readable).
+fail() {
+	echo "FAIL: $*"
+	[[ -s $tmp/out/long_traversal.md ]] && head -30 "$tmp/out/long_traversal.md"
+	[[ -s $tmp/log ]] && tail -20 "$tmp/log"
+	exit 1
+}
 tool="$src/rawlog_tools/gam-long-traversal"
 python3 "$tool" --build "$build" --out "$tmp/out" --laps 1 --frames 120 --snapshot-frames 20 > "$tmp/log" 2>&1 ||
 	{ tail -20 "$tmp/log"; fail "gam-long-traversal failed"; }
