@@ -38,6 +38,28 @@ struct Result
 	ElevationGrid grid;
 };
 
+/** A depth frame of `depth` (mm, K.width x K.height) from a camera `height`
+ * above the floor at the map's origin, rotated by R (sensor to map); max
+ * range 4.5 m. The frame views `depth`, which must outlive it. */
+SensorFrame depthFrame(
+	const std::vector<uint16_t>& depth, const PinholeIntrinsics& K, const Eigen::Matrix3d& R, double height)
+{
+	SensorFrame frame;
+	frame.has_image = true;
+	frame.image.data = depth.data();
+	frame.image.rows = K.height;
+	frame.image.cols = K.width;
+	frame.image.stride = K.width;
+	frame.image.units = 0.001f;
+	frame.image.is_depth = true;
+	frame.intrinsics = K;
+	frame.sensor_to_map.R = R.cast<float>();
+	frame.sensor_to_map.t = Eigen::Vector3f(0, 0, float(height));
+	frame.sensor_position = Eigen::Vector3d(0, 0, height);
+	frame.max_range = 4.5f;
+	return frame;
+}
+
 /** Runs the projector, the 2.5D map, hand-made classes (every cell with
  * samples is Ground) and the detector on `scene`. The grid is 20 x 20 cells
  * from (-0.5, -0.5): the image sees only its middle 10 x 10 cells. */
@@ -48,23 +70,10 @@ void run(
 	K.width = K.height = kSize;
 	K.fx = K.fy = 80;
 	K.cx = K.cy = 19.5;
-	RangeImageView img;
-	img.data = scene.depth.data();
-	img.rows = img.cols = kSize;
-	img.stride = kSize;
-	img.units = 0.001f;
-	img.is_depth = true;
-
-	SensorFrame frame;
-	frame.has_image = true;
-	frame.image = img;
-	frame.intrinsics = K;
 	// Pitch 90 deg (nose down): sensor +X -> world -Z, +Y -> +Y, +Z -> +X.
 	const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-	frame.sensor_to_map.R = R.cast<float>();
-	frame.sensor_to_map.t = Eigen::Vector3f(0, 0, float(kH));
-	frame.sensor_position = Eigen::Vector3d(0, 0, kH);
-	frame.max_range = 4.5f;
+	const SensorFrame frame = depthFrame(scene.depth, K, R, kH);
+	const RangeImageView& img = frame.image;
 
 	GridGeometry g;
 	g.x_min = g.y_min = -0.5;
@@ -431,21 +440,8 @@ TEST(MissingFloor, EmptyRaysDoNotDependOnTheStatisticsRows)
 		}
 	ASSERT_GT(expectedEmpty, 60);
 
-	RangeImageView img;
-	img.data = depth.data();
-	img.rows = H;
-	img.cols = W;
-	img.stride = W;
-	img.units = 0.001f;
-	img.is_depth = true;
-	SensorFrame frame;
-	frame.has_image = true;
-	frame.image = img;
-	frame.intrinsics = K;
-	frame.sensor_to_map.R = R.cast<float>();
-	frame.sensor_to_map.t = Eigen::Vector3f(0, 0, 1);
-	frame.sensor_position = Eigen::Vector3d(0, 0, 1);
-	frame.max_range = 4.5f;
+	const SensorFrame frame = depthFrame(depth, K, R, 1.0);
+	const RangeImageView& img = frame.image;
 	GridGeometry g;
 	g.x_min = 0;  // the floor within 4.5 m, |y| < 3.6 m at the view's edges
 	g.y_min = -4;
