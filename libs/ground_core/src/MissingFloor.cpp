@@ -123,7 +123,6 @@ struct JudgeBounds
 {
 	float thrDown, maxRange, minRange, nx, ny;
 	int32_t cellsPerRow;
-	double rangeBin;  ///< MissingFloorParams::range_bin
 };
 
 void judgeableRow(
@@ -253,7 +252,6 @@ void MissingFloorDetector::compute(
 	bounds.nx = float(g.nx);
 	bounds.ny = float(g.ny);
 	bounds.cellsPerRow = g.nx;
-	bounds.rangeBin = m_params.range_bin;
 
 	// Whether every ray of a row meets the ground within the range (down <
 	// thrDown), none does, or some do: down = n0 + n1 fy + n2 fz over the
@@ -276,6 +274,7 @@ void MissingFloorDetector::compute(
 		if (lo - margin >= double(thrDown)) return RowRays::None;
 		return RowRays::Some;
 	};
+	size_t rayCount = 0, emptyCount = 0;  // stats.rays and stats.empty_rays, counted in registers
 	for (int r = 0; r < img.rows; r += step)
 	{
 		const float* __restrict fyRow = projector.rayYRow(r);
@@ -286,9 +285,43 @@ void MissingFloorDetector::compute(
 		// (The bounds hold for every n-th pixel of a decimated row too.)
 		const RowRays rowAll = rowRays(projector.rowRayBounds(r));
 		if (rowAll == RowRays::None) continue;  // no ray meets the ground within the range: no candidate
+		// A pixel whose ray meets the ground within the range at depth t
+		// (`expected` in the image's own measure) in frame cell `cell`; the
+		// previous pixel of the row was in state `before`. Counts the ray and,
+		// if it came back empty, the cell's empty rays; returns the pixel's
+		// state (0 none, 1 seen floor, 2 empty on seen floor).
+		const auto countRay = [&](int c, double t, double expected, uint32_t cell, int before) {
+			const uint16_t v = raw[c];
+			if (v == 0 && fxBaseline > 0 && missing::outsideSecondImager(c, t, fxBaseline)) return 0;
+			// (v > rawInRange: a return beyond the range, see rawInRange.)
+			const bool empty = v == 0 || (v > rawInRange && double(v) * units > expected + m_params.beyond_margin);
+			rayCount += statsRow;
+			emptyCount += empty;
+			int now = 0;
+			if (statsRow && grid.cell(cell).count > 0)
+			{
+				// Seen floor (or whatever was seen there): its dropouts are the
+				// camera's, not a hole's.
+				const size_t bin = size_t(expected / m_params.range_bin);
+				m_binRays[bin]++;
+				if (empty) m_binEmpty[bin]++;
+				now = empty ? 2 : 1;
+				if (before == 2)
+				{
+					pairsAfterEmpty++;
+					if (empty) pairsBothEmpty++;
+				}
+			}
+			if (empty)
+			{
+				if (m_empty[cell] == 0) m_touched.push_back(cell);
+				if (m_empty[cell] < 65535) m_empty[cell]++;
+			}
+			return now;
+		};
 		// One pixel whose ray may meet the ground within the range, at depth
-		// tf in cell (cxf, cyf). (The statistics rows of depth images take
-		// the same decisions in their own loop below.)
+		// tf in cell (cxf, cyf): the tests, then countRay(). (The statistics
+		// rows of depth images run the tests for a whole row at once.)
 		const auto judgeRay = [&](int c, float tf, float cxf, float cyf) {
 			const int before = prev;
 			prev = 0;
@@ -303,32 +336,9 @@ void MissingFloorDetector::compute(
 			}
 			if (expected < m_params.min_range || expected > maxRange) return;
 			if (!(cxf >= 0.f && cyf >= 0.f)) return;
-			const uint16_t v = raw[c];
-			if (v == 0 && fxBaseline > 0 && missing::outsideSecondImager(c, t, fxBaseline)) return;
 			const int cx = int(cxf), cy = int(cyf);
 			if (cx >= g.nx || cy >= g.ny) return;
-			const double got = double(v) * units;
-			const bool empty = v == 0 || (got > maxRange && got > expected + m_params.beyond_margin);
-			if (statsRow) stats.rays++;
-			if (empty) stats.empty_rays++;
-			const uint32_t cell = uint32_t(g.index(cx, cy));
-			if (statsRow && grid.cell(cell).count > 0)
-			{
-				// Seen floor (or whatever was seen there): its dropouts are the
-				// camera's, not a hole's.
-				const size_t bin = size_t(expected / m_params.range_bin);
-				m_binRays[bin]++;
-				if (empty) m_binEmpty[bin]++;
-				prev = empty ? 2 : 1;
-				if (before == 2)
-				{
-					pairsAfterEmpty++;
-					if (empty) pairsBothEmpty++;
-				}
-			}
-			if (!empty) return;
-			if (m_empty[cell] == 0) m_touched.push_back(cell);
-			if (m_empty[cell] < 65535) m_empty[cell]++;
+			prev = countRay(c, t, expected, uint32_t(g.index(cx, cy)), before);
 		};
 		// The candidates: rays that may meet the ground within the range and,
 		// outside the statistics rows (where only empty rays matter), that
@@ -359,51 +369,14 @@ void MissingFloorDetector::compute(
 		{
 			// A statistics row of a depth image: most of its pixels meet seen
 			// floor. The tests of judgeRay() that need no sample run for the
-			// whole row in one vector loop, then one predictable branch per
-			// pixel judges: the same decisions as judgeRay() (a change to
-			// one is a change to both; the maps were byte-identical).
+			// whole row in one vector loop (judgeableRow), then countRay()
+			// for each pixel that passed them.
 			judgeableRow(rays, bounds, fyRow, fzRow, cols, m_rowT.data(), isCandidate, m_rowCell.data());
 			const float* __restrict T = m_rowT.data();
 			const int32_t* __restrict cellOf = m_rowCell.data();
 			int before = 0;
-			size_t rowRayCount = 0, rowEmpty = 0;
 			for (int c = 0; c < cols; c++)
-			{
-				if (!isCandidate[c])
-				{
-					before = 0;
-					continue;
-				}
-				const uint16_t v = raw[c];
-				if (v == 0 && fxBaseline > 0 && missing::outsideSecondImager(c, double(T[c]), fxBaseline))
-				{
-					before = 0;
-					continue;
-				}
-				const bool empty =
-					v == 0 || (v > rawInRange && double(v) * units > double(T[c]) + m_params.beyond_margin);
-				rowRayCount++;
-				rowEmpty += empty;
-				const uint32_t cell = uint32_t(cellOf[c]);
-				const int now = grid.cell(cell).count > 0 ? (empty ? 2 : 1) : 0;
-				if (now)
-				{
-					const size_t bin = size_t(double(T[c]) / bounds.rangeBin);
-					m_binRays[bin]++;
-					m_binEmpty[bin] += empty;
-					if (before == 2)
-					{
-						pairsAfterEmpty++;
-						pairsBothEmpty += empty;
-					}
-				}
-				before = now;
-				if (!empty) continue;
-				if (m_empty[cell] == 0) m_touched.push_back(cell);
-				if (m_empty[cell] < 65535) m_empty[cell]++;
-			}
-			stats.rays += rowRayCount;
-			stats.empty_rays += rowEmpty;
+				before = isCandidate[c] ? countRay(c, double(T[c]), double(T[c]), uint32_t(cellOf[c]), before) : 0;
 			continue;
 		}
 		// Where every ray of the row meets the ground within the range
@@ -451,6 +424,8 @@ void MissingFloorDetector::compute(
 			else
 				prev = 0;
 	}
+	stats.rays = rayCount;
+	stats.empty_rays = emptyCount;
 	if (pairsAfterEmpty) m_p11 = double(pairsBothEmpty) / double(pairsAfterEmpty);
 
 	// 2. Candidate cells: nothing was seen there, and floor with the dropout
