@@ -471,3 +471,22 @@ TEST(ElevationCellTest, VarianceKeepsItsPrecisionTenMetresUp)
 	EXPECT_EQ(grid.insert(b, f), 6u);
 	EXPECT_NEAR(grid.cell(1, 1).variance(), 9e-6, 1e-8);
 }
+
+TEST(ElevationGrid, SamplesInMarkedCellsAreListedInOrder)
+{
+	// Six samples in cells 3 1 3 2 0 3; cells 1 and 3 marked: the samples at
+	// 0 (cell 3), 1 (cell 1), 2 (cell 3) and 5 (cell 3), in that order.
+	BinnedPoints b;
+	for (uint32_t c : {3u, 1u, 3u, 2u, 0u, 3u}) b.push(c, 0.f);
+	const uint8_t marked[4] = {0, 1, 0, 7};
+	std::vector<uint32_t> out;
+	ASSERT_EQ(samplesInMarkedCells(b, marked, out), 4u);
+	EXPECT_EQ(std::vector<uint32_t>(out.begin(), out.begin() + 4), (std::vector<uint32_t>{0, 1, 2, 5}));
+	// No cell marked: none listed; the buffer is reused, not shrunk.
+	const uint8_t none[4] = {0, 0, 0, 0};
+	EXPECT_EQ(samplesInMarkedCells(b, none, out), 0u);
+	EXPECT_GE(out.size(), 6u);
+	// No samples: none listed.
+	BinnedPoints empty;
+	EXPECT_EQ(samplesInMarkedCells(empty, marked, out), 0u);
+}

@@ -21,6 +21,21 @@ void GridGeometry::validate() const
 	if (!std::isfinite(x_min) || !std::isfinite(y_min)) throw std::invalid_argument("grid origin must be finite");
 }
 
+size_t samplesInMarkedCells(const BinnedPoints& pts, const uint8_t* marked, std::vector<uint32_t>& out)
+{
+	const size_t n = pts.size();
+	if (out.size() < pts.capacity()) out.resize(pts.capacity());
+	const uint32_t* cellOf = pts.cells().begin();
+	uint32_t* list = out.data();
+	size_t listed = 0;
+	for (size_t i = 0; i < n; i++)
+	{
+		list[listed] = uint32_t(i);  // kept only if the cell is marked
+		listed += marked[cellOf[i]] != 0;
+	}
+	return listed;
+}
+
 void ElevationGrid::resize(const GridGeometry& g)
 {
 	g.validate();
@@ -89,6 +104,9 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 	const size_t n = pts.size();
 	const uint32_t* cellOf = pts.cells().begin();
 	const float* zOf = pts.heights().begin();
+	// Pass 2's list, sized with the samples' buffer whether or not this frame
+	// needs it: a later frame then allocates nothing.
+	if (m_flaggedSamples.size() < pts.capacity()) m_flaggedSamples.resize(pts.capacity());
 	// Pass 1: per-cell statistics of this frame. Neighbouring samples mostly
 	// share a cell, and each update then waits for the previous one's store:
 	// walking the two halves of the frame in lockstep interleaves two such
@@ -132,11 +150,11 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 	{
 		// Pass 2, only if some cell had outliers: re-accumulate the flagged
 		// cells (a byte per cell tells which: it stays in the L1 cache).
-		const uint8_t* flaggedCell = m_flagged.data();
-		for (size_t i = 0; i < n; i++)
+		const size_t listed = samplesInMarkedCells(pts, m_flagged.data(), m_flaggedSamples);
+		for (size_t k = 0; k < listed; k++)
 		{
+			const uint32_t i = m_flaggedSamples[k];
 			const uint32_t c = cellOf[i];
-			if (!flaggedCell[c]) continue;
 			if (std::abs(zOf[i] - m_filterMean[c]) <= m_filterLimit[c])
 				accumulate(m_frame[c], zOf[i]);
 			else

@@ -277,11 +277,11 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 	// Most samples lie in other cells (thresholds -inf / +inf): one byte per
 	// cell tells, where the two thresholds are 8 bytes, far apart.
 	for (const TailCandidate& d : m_tailCandidates) m_tailCell[d.cell] = 1;
-	const size_t nCells = m_tailCell.size();
-	for (size_t i = 0; i < cells.size(); i++)
+	const size_t listed = samplesInMarkedCells(samples, m_tailCell.data(), m_tailSamples);
+	for (size_t k = 0; k < listed; k++)
 	{
+		const uint32_t i = m_tailSamples[k];
 		const uint32_t c = cells[i];
-		if (c >= nCells || !m_tailCell[c]) continue;
 		const float z = zs[i];
 		if ((z < m_tailLo[c] && z >= frame.cell(c).z_min) || (z > m_tailHi[c] && z <= frame.cell(c).z_max))
 			m_tailCount[c]++;
@@ -475,6 +475,9 @@ void InverseSensorModel::compute(
 		}
 	}
 
+	// The tail count's list, sized with the samples' buffer on every frame (a
+	// later frame then allocates nothing, candidates or not).
+	if (samples && m_tailSamples.size() < samples->capacity()) m_tailSamples.resize(samples->capacity());
 	if (!m_tailCandidates.empty()) countTailSamples(frame, *samples, stats);
 
 	// Pass 2: the ray to a below-ground voxel crossed the ground plane and went

@@ -119,6 +119,8 @@ class BinnedPoints
    public:
 	void clear() { m_size = 0; }
 	size_t size() const { return m_size; }
+	/** Samples it holds without allocating. */
+	size_t capacity() const { return m_cell.size(); }
 	bool empty() const { return m_size == 0; }
 	ConstSpan<uint32_t> cells() const { return {m_cell.data(), m_size}; }
 	ConstSpan<float> heights() const { return {m_z.data(), m_size}; }
@@ -148,6 +150,17 @@ class BinnedPoints
 	std::vector<float> m_z;
 	size_t m_size = 0;
 };
+
+/** The indices of the samples whose cell is marked (`marked`: a byte per cell,
+ * non-zero = marked), in order, in `out[0..returned)`; `out` only grows, to
+ * `pts.capacity()` (so it allocates when `pts` does). Every
+ * sample's cell must have its byte: the samples are binned on the grid the
+ * bytes are for (as ElevationGrid::insert requires). Written without a branch
+ * per sample: marked cells interleave with others along an image row, a few
+ * samples each, and a test per sample mispredicted at many of those changes
+ * (D435 demo: the 3-sigma filter's second pass and the ISM's tail count each
+ * took 0.1-0.2 ms longer). */
+size_t samplesInMarkedCells(const BinnedPoints& pts, const uint8_t* marked, std::vector<uint32_t>& out);
 
 /** Per-cell outlier removal (paper §IV.A: the 3-sigma rule). */
 struct OutlierFilterParams
@@ -271,7 +284,8 @@ class ElevationGrid
 	std::vector<FrameCell> m_frame;
 	std::vector<uint32_t> m_frameTouched;
 	std::vector<float> m_filterMean, m_filterLimit;
-	std::vector<uint8_t> m_flagged;  // 1: the cell's samples are re-accumulated within mean +- limit
+	std::vector<uint8_t> m_flagged;          // 1: the cell's samples are re-accumulated within mean +- limit
+	std::vector<uint32_t> m_flaggedSamples;  // pass 2: the samples of flagged cells
 	std::vector<float> m_idwWeights;
 	std::vector<uint32_t> m_idwNeighbours;
 };

@@ -334,7 +334,8 @@ class InverseSensorModel
 	const IsmParams& params() const { return m_params; }
 
 	/** Computes the evidence of one frame. `samples` are the heights the frame
-	 * was built from (for deep_sample_test; without them the test is skipped).
+	 * was built from, binned on its grid (for deep_sample_test and the tail
+	 * counts; without them the test is skipped).
 	 * `sensor` is the sensor position in
 	 * the grid frame; voxels farther than `maxRange` from it (2D) are ignored.
 	 * With no ground plane (det.ok() false) nothing is produced: a frame
@@ -452,7 +453,8 @@ class InverseSensorModel
 	std::vector<TailCandidate> m_tailCandidates;
 	std::vector<float> m_tailLo, m_tailHi;
 	std::vector<uint32_t> m_tailCount;
-	std::vector<uint8_t> m_tailCell;  ///< 1 for the tail candidates' cells (during countTailSamples)
+	std::vector<uint8_t> m_tailCell;      ///< 1 for the tail candidates' cells (during countTailSamples)
+	std::vector<uint32_t> m_tailSamples;  ///< the samples in those cells (during countTailSamples)
 	// Local-plane support raster: bit k set = plane k applies in that block.
 	std::vector<uint8_t> m_support;
 	int m_blockCells = 4, m_bnx = 0, m_bny = 0;
