@@ -1152,3 +1152,34 @@ TEST(InverseSensorModel, FloorNoiseIsMeasuredOnAnUpperStoreyToo)
 	ism.compute(frame, handDetection(upperFloor), sensor, 5.0, st);
 	EXPECT_NEAR(ism.groundBand(sensor, 1.0, std::sqrt(1.25 * 1.25 - 1), 0, 10), 0.039, 1e-5);
 }
+
+TEST(InverseSensorModel, FloorOffsetIsMeasuredWithoutTheFloorNoise)
+{
+	// measure_floor_noise and measure_floor_offset are separate switches (the
+	// ablation switches one off at a time). Ten floor cells at x = 1.025, y =
+	// -0.225 ... 0.225, seen from (0, 0, 1): ranges sqrt(1.025^2 + y^2 + 1) =
+	// 1.4322 ... 1.4496, all in the 0.5 m bin [1.0, 1.5); 4 samples each, the
+	// cells' means alternately +4 mm and -4 mm. tau = 1.4826 x the median
+	// |mean| = 1.4826 x 0.004 = 0.0059304.
+	ElevationGrid grid;
+	BinnedPoints b;
+	for (int i = 0; i < 10; i++)
+		for (int k = 0; k < 4; k++) grid.binPoint(1.025, -0.225 + 0.05 * i, i % 2 ? -0.004f : 0.004f, b);
+	OutlierFilterParams f;
+	f.enabled = false;
+	grid.insert(b, f);
+	const Eigen::Vector3d sensor(0, 0, 1);
+	auto tauWith = [&](bool noise, bool offset) {
+		IsmParams p;
+		p.measure_floor_noise = noise;
+		p.measure_floor_offset = offset;
+		InverseSensorModel ism(p);
+		IsmStats st;
+		ism.compute(grid, handDetection(kFloor), sensor, 5.0, st, &b);
+		return ism.floorOffset(sensor, 1.025, 0.025, 0.0);
+	};
+	EXPECT_NEAR(tauWith(true, true), 0.0059304, 1e-6);
+	EXPECT_NEAR(tauWith(false, true), 0.0059304, 1e-6);
+	EXPECT_EQ(tauWith(true, false), -1.0);
+	EXPECT_EQ(tauWith(false, false), -1.0);
+}

@@ -91,7 +91,9 @@ void InverseSensorModel::measureFloorNoise(
 	m_floorNoise.assign(nb, -1.f);
 	m_floorOffset.assign(nb, -1.f);
 	m_offsetValue.clear();
-	if (!m_params.measure_floor_noise || m_params.noise_sigmas <= 0) return;
+	// The two measurements are separate switches: the floor offset (tau) is
+	// measured without the noise, and the other way round.
+	if ((!m_params.measure_floor_noise && !m_params.measure_floor_offset) || m_params.noise_sigmas <= 0) return;
 	m_noiseBin.clear();
 	m_noiseValue.clear();
 	for (uint32_t idx : frame.observedCells())
@@ -130,8 +132,11 @@ void InverseSensorModel::measureFloorNoise(
 		const size_t n = end - begin;
 		if (n < size_t(std::max(1, m_params.floor_noise_min_cells))) continue;
 		float* v = m_noiseSorted.data() + begin;
-		std::nth_element(v, v + long(n / 2), v + n);
-		m_floorNoise[b] = v[n / 2];
+		if (m_params.measure_floor_noise)
+		{
+			std::nth_element(v, v + long(n / 2), v + n);
+			m_floorNoise[b] = v[n / 2];
+		}
 		// The cells' means around the plane: 1.4826 x the median |distance| is
 		// their std for a normal spread (robust to the odd bump among them).
 		float* o = m_offsetSorted.data() + begin;
