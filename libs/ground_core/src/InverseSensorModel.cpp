@@ -504,7 +504,6 @@ void InverseSensorModel::compute(
 		const double ex = sensor.x() + t * (x - sensor.x()), ey = sensor.y() + t * (y - sensor.y());
 		double lx = x - ex, ly = y - ey;
 		double len = std::sqrt(lx * lx + ly * ly);
-		if (len < res) continue;
 		// The ray got to the crossing only if nothing stood in its way. The
 		// sample (its cell's centre and z_min) may put the crossing in the
 		// shadow of a box, which no ray reached: then the cells would be

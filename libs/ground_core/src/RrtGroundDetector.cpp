@@ -799,7 +799,10 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 	for (int round = 0; int(out.planes.size()) < maxPlanes && remaining.size() >= 3 && round < 2 * maxPlanes; round++)
 	{
 		const int k = int(out.planes.size());
-		rp.min_inliers = k == 0 ? std::max<size_t>(3, minNodes() / 2) : m_params.min_nodes_per_extra_plane;
+		// The ground plane: any 3 nodes, as in the paper (it took min_nodes / 2
+		// = 4 until issue #27, which changed no cell of the 27 scenes with any
+		// camera model; the tree has min_nodes nodes anyway).
+		rp.min_inliers = k == 0 ? 3 : m_params.min_nodes_per_extra_plane;
 		if (k > 0 && m_params.min_nodes_per_extra_plane == 0) break;
 		pts.clear();
 		for (size_t i : remaining) pts.emplace_back(out.nodes[i].x, out.nodes[i].y, out.nodes[i].z);
