@@ -281,29 +281,22 @@ TEST(ElevationGridFilter, KeepsInliersFarFromZeroHeight)
 	}
 }
 
-TEST(ElevationGridFilter, NoMinimumBand)
+TEST(ElevationGridFilter, MinimumBand)
 {
-	// {0 x8, 0.004 x2}: mean 0.0008, std sqrt(0.8 x 0.2) x 0.004 = 0.0016. A
-	// 1-sigma band (0.0008 +- 0.0016) drops the two 4 mm samples (3.2 mm from
-	// the mean): no minimum band widens it (the default had +-5 mm).
-	BinnedPoints b;
+	// {0 x8, 0.004 x2}: mean 0.0008, std 0.0016. A 1-sigma band (+-1.6 mm)
+	// would drop the two 4 mm samples; the 5 mm minimum band keeps them.
 	ElevationGrid grid(makeGeometry(0, 0, 1.0, 2, 2));
+	BinnedPoints b;
 	for (int i = 0; i < 8; i++) grid.binPoint(0.5, 0.5, 0.f, b);
 	for (int i = 0; i < 2; i++) grid.binPoint(0.5, 0.5, 0.004f, b);
 	OutlierFilterParams f;
 	f.sigmas = 1.0f;
-	EXPECT_EQ(grid.insert(b, f), 8u);
-	EXPECT_EQ(grid.cell(0, 0).count, 8u);
-	EXPECT_FLOAT_EQ(grid.cell(0, 0).z_max, 0.f);
-	// A 2.5-sigma band (+-4 mm) keeps all ten.
+	EXPECT_EQ(grid.insert(b, f), 10u);
+	EXPECT_EQ(grid.cell(0, 0).count, 10u);
+	f.min_band = 0.f;
 	ElevationGrid g2(makeGeometry(0, 0, 1.0, 2, 2));
-	f.sigmas = 2.5f;
-	EXPECT_EQ(g2.insert(b, f), 10u);
-	// Ten equal samples (std 0): none dropped.
-	ElevationGrid g3(makeGeometry(0, 0, 1.0, 2, 2));
-	BinnedPoints flat;
-	for (int i = 0; i < 10; i++) g3.binPoint(0.5, 0.5, 0.25f, flat);
-	EXPECT_EQ(g3.insert(flat, OutlierFilterParams{}), 10u);
+	EXPECT_EQ(g2.insert(b, f), 8u);
+	EXPECT_FLOAT_EQ(g2.cell(0, 0).z_max, 0.f);
 }
 
 namespace

@@ -136,7 +136,7 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 		const float inv = 1.0f / float(a.count);
 		const float m1 = a.s1 * inv;
 		const float var = std::max(0.f, a.s2 * inv - m1 * m1);
-		const float lim = filter.sigmas * std::sqrt(var);
+		const float lim = std::max(filter.min_band, filter.sigmas * std::sqrt(var));
 		const float mean = a.ref + m1;
 		if (mean - lim <= a.z_min && mean + lim >= a.z_max) continue;
 		m_filterMean[c] = mean;

@@ -45,6 +45,13 @@ ProjectionFilter PipelineParams::projectionFilter(double robotZ) const
 	return f;
 }
 
+OutlierFilterParams PipelineParams::outlierFilter() const
+{
+	OutlierFilterParams f = outliers;
+	if (ism.model == MethodVariant::Paper) f.min_band = 0.f;
+	return f;
+}
+
 GroundAwarePipeline::GroundAwarePipeline(const PipelineParams& p) { setParams(p); }
 
 void GroundAwarePipeline::setParams(const PipelineParams& p)
@@ -132,7 +139,7 @@ const FrameResult& GroundAwarePipeline::process(
 	if (!paperIsm && noise.baseline > 0) filter.drop_flying_pixels = false;
 	m_result.samples = binSensorFrame(frame, filter, m_grid, m_projector, m_bins);
 	const auto t1 = clk::now();
-	m_result.points = m_grid.insert(m_bins, m_params.outliers);
+	m_result.points = m_grid.insert(m_bins, m_params.outlierFilter());
 	if (m_params.idw.radius_cells > 0)
 	{
 		m_grid.interpolateIdw(m_params.idw);

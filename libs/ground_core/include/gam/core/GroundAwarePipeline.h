@@ -84,6 +84,10 @@ struct PipelineParams
 	/** The projector's filter for a robot standing at height `robotZ` (map
 	 * frame): the robot-frame z band, cropped at robot_height. */
 	ProjectionFilter projectionFilter(double robotZ) const;
+	/** The 3-sigma rule as run: `outliers`, without the minimum band in the
+	 * paper's model (the default's 5 mm keeps the samples of a perfectly
+	 * flat cell from being cut by round-off). */
+	OutlierFilterParams outlierFilter() const;
 };
 
 /** The cells of the frame grid are aligned with this lattice: its corner
