@@ -539,17 +539,22 @@ int main(int argc, char** argv)
 				const LeddarScan ls = leddar.scan(scene, ledWorld, rngLeddar);
 				if (frameTruth)
 				{
-					// the cells under the beams, up to the echo (or the range limit)
-					const double w = sf.leddar.hfov_deg / sf.leddar.segments * M_PI / 180.0;
+					// the cells under the beams: each part of a segment's cone up
+					// to where its own light stopped (the echo is the nearest of
+					// them: the rest of the cone reaches farther, to the wall a
+					// segment sees obliquely), or the range limit
 					for (int sgm = 0; sgm < sf.leddar.segments; sgm++)
 						for (int a = 0; a < sf.leddar.sub_h; a++)
 						{
-							const double h = sf.leddar.segmentAngle(sgm) - 0.5 * w + (a + 0.5) * w / sf.leddar.sub_h;
+							const double h = sf.leddar.subRayAngle(sgm, a);
 							const Eigen::Vector3d dir = ledWorld.R * Eigen::Vector3d(std::cos(h), std::sin(h), 0);
-							// up to the echo and 3 sigma beyond it (where its noisy range may put it)
-							const double len = ls.valid[size_t(sgm)]
-												   ? double(ls.range[size_t(sgm)]) + 3 * sf.leddar.sigma
-												   : sf.leddar.max_range;
+							const RayHit own = scene.cast(ledWorld.t, dir, 1e-6, sf.leddar.max_range);
+							// up to there and 3 sigma beyond the echo (where its noisy range may put it)
+							const double len =
+								ls.valid[size_t(sgm)]
+									? std::max(own.hit ? own.t : sf.leddar.max_range, double(ls.range[size_t(sgm)])) +
+										  3 * sf.leddar.sigma
+									: sf.leddar.max_range;
 							const Eigen::Vector2d from = ledWorld.t.head<2>();
 							frameTruth->sweep(gt, from, from + len * dir.head<2>().normalized(), 2);
 						}

@@ -35,7 +35,10 @@ const std::vector<std::pair<std::string, std::string>>& paperOverrides()
 {
 	// rawlog_tools/gam-ablation-ini, row "paper" (tests/nav checks they agree)
 	static const std::vector<std::pair<std::string, std::string>> kv = {
-		{"ism_model", "paper"}, {"rrt_variant", "paper"}, {"scan_keeps_3d_obstacles", "false"}};
+		{"ism_model", "paper"},
+		{"rrt_variant", "paper"},
+		{"scan_keeps_3d_obstacles", "false"},
+		{"sparse_scan_near_edge", "false"}};
 	return kv;
 }
 

@@ -11,11 +11,11 @@ trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
 read -r -a labels <<< "$(bash "$tool" --labels)"
-[[ ${#labels[@]} -eq 18 ]] || fail "18 labels expected, got ${#labels[@]}: ${labels[*]}"
+[[ ${#labels[@]} -eq 19 ]] || fail "19 labels expected, got ${#labels[@]}: ${labels[*]}"
 [[ ${labels[0]} == ground_aware && ${labels[1]} == paper ]] || fail "the default and the paper first: ${labels[*]}"
 
 bash "$tool" "$src/config/ground-aware-mapper.ini" > "$tmp/ablation.ini"
-grep -qx "groundAwareGrid_count=18" "$tmp/ablation.ini" || fail "groundAwareGrid_count=18 missing"
+grep -qx "groundAwareGrid_count=19" "$tmp/ablation.ini" || fail "groundAwareGrid_count=19 missing"
 # The _groundOpts section of the grid labelled $1, as KEY=VALUE lines without comments.
 opts_of() {
 	local nn
@@ -29,7 +29,10 @@ for l in "${labels[@]}"; do opts_of "$l" > /dev/null; done
 opts_of paper | grep -qx "ism_model=paper" || fail "paper: ism_model=paper"
 opts_of paper | grep -qx "rrt_variant=paper" || fail "paper: rrt_variant=paper"
 opts_of paper | grep -qx "scan_keeps_3d_obstacles=false" || fail "paper: the beam model for 2D scans"
+opts_of paper | grep -qx "sparse_scan_near_edge=false" || fail "paper: a sparse scan's arcs"
 opts_of no_scan_rule | grep -qx "scan_keeps_3d_obstacles=false" || fail "no_scan_rule"
+opts_of no_near_edge_scan | grep -qx "sparse_scan_near_edge=false" || fail "no_near_edge_scan"
+opts_of ground_aware | grep -qx "sparse_scan_near_edge=true" || fail "ground_aware keeps the near-edge scans"
 opts_of ground_aware | grep -qx "scan_keeps_3d_obstacles=true" || fail "ground_aware keeps the base's scan rule"
 opts_of no_min_points | grep -qx "min_drop_points=1" || fail "no_min_points: min_drop_points=1"
 opts_of no_range_of_trust | grep -qx "range_of_trust=false" || fail "no_range_of_trust"

@@ -266,6 +266,21 @@ TEST(GroundAwareGrid, AutoScanRuleIsTheBeamModelUntilTheFirstDepthFrame)
 	EXPECT_FALSE(automatic.scanRuleActive());
 }
 
+namespace
+{
+// A 16-segment Leddar's scan over 45 deg, MRPT's convention: segment i at
+// -22.5 + 3 i deg (s = 45 / 15 = 3 deg), every range still to be set.
+mrpt::obs::CObservation2DRangeScan leddar16()
+{
+	mrpt::obs::CObservation2DRangeScan s;
+	s.aperture = float(DEG2RAD(45.0));
+	s.rightToLeft = true;
+	s.maxRange = 50;
+	s.resizeScan(16);
+	return s;
+}
+}  // namespace
+
 TEST(GroundAwareGrid, LeddarSegmentEchoStaysInItsOwnCone)
 {
 	// 16 segments over a 45 deg aperture: segment i points at -22.5 + 3 i deg
@@ -273,11 +288,7 @@ TEST(GroundAwareGrid, LeddarSegmentEchoStaysInItsOwnCone)
 	// its rays are 3 / 8 = 0.375 deg apart: segment 0's at -22.5 - 1.5 +
 	// 0.1875 = -23.8125 ... -21.1875 deg, and the new aperture is
 	// (16 * 8 - 1) * 3 / 8 = 47.625 deg.
-	mrpt::obs::CObservation2DRangeScan s;
-	s.aperture = float(DEG2RAD(45.0));
-	s.rightToLeft = true;
-	s.maxRange = 50;
-	s.resizeScan(16);
+	auto s = leddar16();
 	for (size_t i = 0; i < 16; i++) s.setScanRangeValidity(i, false);
 	s.setScanRange(0, 6.0f);  // only segment 0 has an echo, 6 m away
 	s.setScanRangeValidity(0, true);
@@ -301,6 +312,132 @@ TEST(GroundAwareGrid, LeddarSegmentEchoStaysInItsOwnCone)
 	// border on (6 m x 0.6 deg = 6 cm, more than a 5 cm cell; the old rays
 	// reached -20.0 deg).
 	for (double deg = -20.4; deg <= -18.0; deg += 0.2) EXPECT_NEAR(pOcc(g, x(deg), y(deg)), 0.5, 1e-3) << deg << " deg";
+}
+
+namespace
+{
+// A 16-segment Leddar over 45 deg (segment i at -22.5 + 3 i deg, covering 3
+// deg around it), each segment's range the nearest point of the wall x = D
+// in its cone (the echo a wide beam reports): D / cos of the cone's edge
+// nearest 0 deg (0 for the two central segments, whose cones end at 0).
+mrpt::obs::CObservation2DRangeScan leddarFacingWall(double D)
+{
+	auto s = leddar16();
+	for (size_t i = 0; i < 16; i++)
+	{
+		const double c = -22.5 + 3.0 * double(i), nearest = std::min(std::abs(c - 1.5), std::abs(c + 1.5));
+		s.setScanRange(i, float(D / std::cos(DEG2RAD(c > -1.5 && c < 1.5 ? 0.0 : nearest))));
+		s.setScanRangeValidity(i, true);
+	}
+	return s;
+}
+// Angle of ray o of a 16-segment, 45 deg scan upsampled with k = 8: segment
+// o / 8's cone from its centre - 1.5 deg, rays 3 / 8 deg apart at the parts' centres.
+double upsampledRayDeg(size_t o) { return -22.5 + 3.0 * double(o / 8) - 1.5 + (double(o % 8) + 0.5) * 0.375; }
+}  // namespace
+
+TEST(GroundAwareGrid, LeddarRaysEndOnTheWallTheSegmentsSawObliquely)
+{
+	// A wall 5.8 m ahead. Segment 15 (cone 21..24 deg) reports the wall's
+	// nearest point in its cone, 5.8 / cos 21 = 6.2126 m. As an arc, its
+	// outer ray (23.8125 deg) ended at x = 6.2126 cos 23.8125 = 5.6838 m:
+	// 11.6 cm (two cells) in front of the wall. With the near-edge echoes,
+	// every ray of every segment ends on the wall: x = r cos a = 5.8.
+	const double D = 5.8;
+	const auto s = leddarFacingWall(D);
+	ASSERT_NEAR(s.getScanRange(15), 6.2126, 1e-4);
+	const auto arc = CGroundAwareOccupancyGrid::upsampleSparseScan(s, 8, false);
+	EXPECT_NEAR(arc.getScanRange(127) * std::cos(DEG2RAD(upsampledRayDeg(127))), 5.6838, 1e-4);
+	const auto up = CGroundAwareOccupancyGrid::upsampleSparseScan(s, 8);
+	ASSERT_EQ(up.getScanSize(), 128u);
+	for (size_t o = 0; o < 128; o++)
+	{
+		ASSERT_TRUE(up.getScanRangeValidity(o));
+		EXPECT_NEAR(up.getScanRange(o) * std::cos(DEG2RAD(upsampledRayDeg(o))), D, 1e-4) << "ray " << o;
+		// Never nearer than the segment's echo (nothing in its cone is).
+		EXPECT_GE(up.getScanRange(o), s.getScanRange(o / 8) - 1e-6f) << "ray " << o;
+	}
+	// In the grid (MRPT's beam model: no depth frame yet): occupied cells
+	// more than a cell in front of the wall (centres x <= 5.725). The arcs
+	// put some there: segment 15's rays end at x = 6.2126 cos a < 5.75 for
+	// a > 22.26 deg (its 5 outer rays), segment 14's (6.0985 m) for a >
+	// 19.45 deg, and so on inward. On the wall: none.
+	CGroundAwareOccupancyGrid g(-8, 8, -8, 8, 0.05f), arcGrid(-8, 8, -8, 8, 0.05f);
+	auto o = arcGrid.groundOptions();
+	o.sparse_scan_near_edge = false;
+	arcGrid.setGroundOptions(o);
+	ASSERT_TRUE(g.insertObservation(s));
+	ASSERT_TRUE(arcGrid.insertObservation(s));
+	const auto inFront = [&](const CGroundAwareOccupancyGrid& grid) {
+		int n = 0;
+		for (double x = 4.025; x < 5.75; x += 0.05)
+			for (double y = -3.0; y <= 3.0; y += 0.05) n += pOcc(grid, x, y) > 0.5;
+		return n;
+	};
+	EXPECT_GE(inFront(arcGrid), 10);
+	EXPECT_EQ(inFront(g), 0);
+	for (double deg : {-23.5, 0.0, 23.5})
+		EXPECT_GT(pOccNear(g, D, D * std::tan(DEG2RAD(deg))), 0.6) << deg << " deg: the wall";
+}
+
+TEST(GroundAwareGrid, LeddarRaysInACorridorEndOnBothWalls)
+{
+	// A corridor 2.87 m wide (wall faces y = +-1.435) closed 7.8 m ahead, the
+	// Leddar on its axis. Each segment's echo: the nearest wall point in its
+	// cone (found on 3001 directions). A ray that ends on a wall is within
+	// 2 cm of it, on either side: the two halves are mirror images.
+	auto s = leddar16();
+	const auto wallRange = [](double a) {
+		const double toSide = std::abs(std::sin(a)) > 1e-9 ? 1.435 / std::abs(std::sin(a)) : 1e9;
+		return std::min(toSide, 7.8 / std::cos(a));
+	};
+	for (size_t i = 0; i < 16; i++)
+	{
+		double best = 1e9;
+		for (int q = 0; q <= 3000; q++) best = std::min(best, wallRange(DEG2RAD(-24.0 + 3.0 * i + 3.0 * q / 3000.0)));
+		s.setScanRange(i, float(best));
+		s.setScanRangeValidity(i, true);
+	}
+	const auto up = CGroundAwareOccupancyGrid::upsampleSparseScan(s, 8);
+	for (size_t o = 0; o < 128; o++)
+	{
+		const double a = DEG2RAD(upsampledRayDeg(o)), r = up.getScanRange(o);
+		EXPECT_LE(r, wallRange(a) + 0.02) << "ray " << o << " ends behind the wall";
+		EXPECT_NEAR(r, up.getScanRange(127 - o), 1e-3) << "ray " << o << " and its mirror image";
+		// Segments 0-3 and 12-15 see a side wall over the whole cone and so
+		// do their neighbours, segments 6-9 the end wall (the side walls end
+		// at atan(1.435 / 7.8) = 10.4 deg, in segments 4 and 11): on the wall.
+		const size_t seg = o / 8;
+		if (seg <= 3 || seg >= 12 || (seg >= 6 && seg <= 9))
+		{
+			EXPECT_NEAR(r, wallRange(a), 0.02) << "ray " << o << " of segment " << seg;
+		}
+	}
+	// As an arc, segment 0 (echo 1.435 / sin 24 = 3.528 m) ended its inner
+	// ray (21.1875 deg, the wall 1.435 / sin 21.1875 = 3.970 m away) 44 cm
+	// in front of the wall.
+	const auto arc = CGroundAwareOccupancyGrid::upsampleSparseScan(s, 8, false);
+	EXPECT_NEAR(wallRange(DEG2RAD(upsampledRayDeg(7))) - arc.getScanRange(7), 0.442, 0.001);
+}
+
+TEST(GroundAwareGrid, LeddarPoleAndJumpKeepTheirArcs)
+{
+	// Where the nearest point may lie anywhere in the cone, the arc stays:
+	// - a pole 2 m away in segment 5 (both neighbours see the wall farther):
+	//   a local minimum;
+	// - segments 9..11 on a box 2 m away, segment 12 (cone 12..15 deg) on the
+	//   wall beyond, 5.8 / cos 12 = 5.9296 m: segment 11's chord runs from
+	//   its echo at its near edge, 2 m at 9 deg = (1.9754, 0.3129), to
+	//   segment 12's at the shared edge, 5.9296 m at 12 deg = (5.8, 1.2328):
+	//   d = (3.8246, 0.9199), |d| = 3.9337; for the middle ray (10.5 deg)
+	//   cross(u, d) = 0.98325 x 0.9199 - 0.18224 x 3.8246 = 0.2075, so the
+	//   chord is asin(0.2075 / 3.9337) = 3.0 deg from the rays: a jump, not
+	//   a surface at >= 10 deg from them.
+	auto s = leddarFacingWall(5.8);
+	for (size_t i : {5u, 9u, 10u, 11u}) s.setScanRange(i, 2.0f);
+	const auto up = CGroundAwareOccupancyGrid::upsampleSparseScan(s, 8);
+	for (size_t i : {5u, 11u})
+		for (size_t j = 0; j < 8; j++) EXPECT_FLOAT_EQ(up.getScanRange(i * 8 + j), 2.0f) << "segment " << i;
 }
 
 TEST(GroundAwareGrid, LeddarBeamsOverAHoleDoNotClearIt)

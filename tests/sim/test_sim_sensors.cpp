@@ -193,6 +193,11 @@ TEST(SimLeddar, SegmentsAndNearestReturn)
 	ASSERT_EQ(s.range.size(), 16u);
 	EXPECT_NEAR(lp.segmentAngle(0), -22.5 * kDeg, 1e-12);
 	EXPECT_NEAR(lp.segmentAngle(15), 22.5 * kDeg, 1e-12);
+	// Segment 15's cone: 22.5 -+ 45 / 16 / 2 = 21.09375 .. 23.90625 deg; its
+	// echo from the near edge: 5 / cos 21.09375 = 5 / 0.932993 = 5.35910 m.
+	EXPECT_NEAR(lp.subRayAngle(15, 0), 21.09375 * kDeg, 1e-12);
+	EXPECT_NEAR(lp.subRayAngle(15, lp.sub_h - 1), 23.90625 * kDeg, 1e-12);
+	EXPECT_NEAR(s.range[15], 5.35910, 1e-5);
 	for (int i = 0; i < 16; i++)
 	{
 		ASSERT_TRUE(s.valid[size_t(i)]);
@@ -205,11 +210,12 @@ TEST(SimLeddar, SegmentsAndNearestReturn)
 		}
 		else
 		{
-			// nearest sub-ray on the wall at x = 5: 5 / cos(smallest |angle| of the
-			// segment's sub-rays; the middle vertical sub-ray is level)
+			// nearest sub-ray on the wall at x = 5: the cone's near edge (the
+			// sub-rays span the cone edge to edge; the middle vertical one is
+			// level), 5 / cos(|a| - w / 2)
 			const double w = 45.0 / 16 * kDeg;
-			const double hmin = std::abs(a) - 0.5 * w + 0.5 * w / lp.sub_h;
-			EXPECT_NEAR(s.range[size_t(i)], 5.0 / std::cos(hmin), 0.02) << i;
+			const double hmin = std::abs(a) - 0.5 * w;
+			EXPECT_NEAR(s.range[size_t(i)], 5.0 / std::cos(hmin), 1e-5) << i;
 			EXPECT_EQ(s.object_id[size_t(i)], 6);
 		}
 	}

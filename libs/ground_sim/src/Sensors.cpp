@@ -458,6 +458,12 @@ double LeddarParams::segmentAngle(int i) const
 	return segments > 1 ? -0.5 * ap + i * ap / (segments - 1) : 0.0;
 }
 
+double LeddarParams::subRayAngle(int i, int a) const
+{
+	const double w = hfov_deg * kDeg / segments;
+	return sub_h > 1 ? segmentAngle(i) - 0.5 * w + a * w / (sub_h - 1) : segmentAngle(i);
+}
+
 LeddarScan LeddarModel::scan(const Scene& scene, const Pose3& sensor, std::mt19937& rng) const
 {
 	LeddarScan s;
@@ -465,7 +471,7 @@ LeddarScan LeddarModel::scan(const Scene& scene, const Pose3& sensor, std::mt199
 	s.valid.assign(size_t(p.segments), false);
 	s.object_id.assign(size_t(p.segments), 0);
 	std::normal_distribution<double> gauss(0.0, 1.0);
-	const double w = p.hfov_deg * kDeg / p.segments, vf = p.vfov_deg * kDeg;
+	const double vf = p.vfov_deg * kDeg;
 	for (int i = 0; i < p.segments; i++)
 	{
 		double best = std::numeric_limits<double>::infinity();
@@ -473,7 +479,7 @@ LeddarScan LeddarModel::scan(const Scene& scene, const Pose3& sensor, std::mt199
 		for (int a = 0; a < p.sub_h; a++)
 			for (int b = 0; b < p.sub_v; b++)
 			{
-				const double h = p.segmentAngle(i) - 0.5 * w + (a + 0.5) * w / p.sub_h;
+				const double h = p.subRayAngle(i, a);
 				const double v = -0.5 * vf + (b + 0.5) * vf / p.sub_v;
 				const Eigen::Vector3d dl(std::cos(v) * std::cos(h), std::cos(v) * std::sin(h), std::sin(v));
 				const RayHit hit = scene.cast(sensor.t, sensor.R * dl, 1e-6, p.max_range);

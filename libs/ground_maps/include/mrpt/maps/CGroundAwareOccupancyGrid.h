@@ -71,6 +71,11 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		gam::PipelineParams pipeline;
 		// 2D scans
 		int sparse_scan_upsampling = 8;  ///< rays per beam for scans of < 64 beams (Leddar)
+		/** Where a sparse scan's ranges recede from beam to beam, a beam's
+		 * rays end on the surface through its and its neighbour's echoes at
+		 * their cones' near edges, not on an arc at its echo's range (see
+		 * upsampleSparseScan). */
+		bool sparse_scan_near_edge = true;
 		/** What a 2D scan may do to the grid (the walker's rule, issue #31):
 		 * - `true`: a planar beam passes over holes, cables and small boxes, so
 		 *   2D scans add their hits and make no cell freer: only floor the depth
@@ -114,6 +119,12 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 			visit(
 				gam::ParamInfo{"sparse_scan_upsampling", 1, 1000, "rays per beam for scans with < 64 beams"},
 				o.sparse_scan_upsampling);
+			visit(
+				gam::ParamInfo{
+					"sparse_scan_near_edge", 0, 1,
+					"a sparse scan's beam ends on the surface through its neighbours' near-edge echoes where the "
+					"ranges recede (false: an arc at its echo's range)"},
+				o.sparse_scan_near_edge);
 			visit(
 				gam::ParamInfo{
 					"scan_keeps_3d_obstacles", 0, 2,
@@ -227,9 +238,17 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	 * into k rays, so the base beam model covers each segment's full width:
 	 * beam i (at -aperture/2 + i s, s = aperture / (N - 1)) covers s around
 	 * its direction, and its rays sit s / k apart inside that cone (the
-	 * aperture grows to (N k - 1) s / k). */
+	 * aperture grows to (N k - 1) s / k).
+	 * With `nearEdge`, where the ranges recede from beam to beam (a surface
+	 * seen obliquely), a beam's echo (the nearest return in its cone) lies at
+	 * the cone's edge toward its nearer neighbour, and its rays end on the
+	 * chord from that point to the neighbour's echo at the shared edge (never
+	 * nearer than the echo; the arc where the chord meets the rays within
+	 * kMinIncidence of grazing: a jump, not a surface). */
 	static mrpt::obs::CObservation2DRangeScan upsampleSparseScan(
-		const mrpt::obs::CObservation2DRangeScan& in, int raysPerBeam);
+		const mrpt::obs::CObservation2DRangeScan& in, int raysPerBeam, bool nearEdge = true);
+	/** See upsampleSparseScan: 10 deg. [rad] */
+	static constexpr double kMinIncidence = 10.0 * M_PI / 180.0;
 
 	std::string asString() const override;
 

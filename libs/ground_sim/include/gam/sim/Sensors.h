@@ -178,6 +178,11 @@ struct LeddarParams
 	double quantum = 0.01;
 	/** Centre angle of segment i [rad] (MRPT getScanAngle convention). */
 	double segmentAngle(int i) const;
+	/** Horizontal angle of sub-ray a (0..sub_h-1) of segment i [rad]: sub_h
+	 * directions from one edge of the segment's hfov/segments cone to the
+	 * other, so that the nearest return found is the cone's, edges included
+	 * (the echo of a wall seen obliquely comes from the cone's near edge). */
+	double subRayAngle(int i, int a) const;
 };
 
 struct LeddarScan
