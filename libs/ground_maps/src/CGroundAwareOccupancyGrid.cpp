@@ -332,9 +332,9 @@ mrpt::obs::CObservation2DRangeScan CGroundAwareOccupancyGrid::upsampleSparseScan
 		// Elsewhere (a nearest point inside the cone: a pole, the foot of the
 		// perpendicular; no neighbour echo; a jump that no surface at more
 		// than kMinIncidence from the rays makes): the arc. (A concave corner
-		// in the neighbour's cone puts the chord in front of the corner;
-		// refusing a neighbour at a local maximum of the ranges was tried and
-		// marked more floor, 27 scenes: D435 1176 -> 1215 cells.)
+		// in the neighbour's cone can put the chord in front of the corner;
+		// two checks for it were tried and marked more floor on the 27 scenes,
+		// D435 1176 -> 1215 and -> 1191 cells: see doc/benchmark.md.)
 		double ax = 0, ay = 0, bx = 0, by = 0;
 		bool chord = false;
 		if (nearEdge && valid(i) && N > 1)
