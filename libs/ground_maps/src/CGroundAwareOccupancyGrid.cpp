@@ -364,19 +364,18 @@ mrpt::obs::CObservation2DRangeScan CGroundAwareOccupancyGrid::upsampleSparseScan
 				chord = true;
 			}
 		}
+		// The ray (cos a, sin a) t meets A + (B - A) u where
+		// t = cross(A, B - A) / cross(ray, B - A).
+		const double dx = bx - ax, dy = by - ay, len = std::hypot(dx, dy), cross = ax * dy - ay * dx;
 		for (int j = 0; j < k; j++)
 		{
 			const size_t o = i * size_t(k) + size_t(j);
 			double ro = r;
 			if (chord)
 			{
-				// The ray (cos a, sin a) t meets A + (B - A) u where
-				// t = cross(A, B - A) / cross(ray, B - A).
 				const double a = centre(i) - 0.5 * s + (j + 0.5) * s / k;
-				const double ux = std::cos(a), uy = std::sin(a), dx = bx - ax, dy = by - ay;
-				const double len = std::hypot(dx, dy), den = ux * dy - uy * dx;
-				if (len > 0 && std::abs(den) >= len * std::sin(kMinIncidence))
-					ro = std::max(r, (ax * dy - ay * dx) / den);
+				const double den = std::cos(a) * dy - std::sin(a) * dx;
+				if (len > 0 && std::abs(den) >= len * std::sin(kMinIncidence)) ro = std::max(r, cross / den);
 			}
 			out.setScanRange(o, float(ro));
 			out.setScanRangeValidity(o, in.getScanRangeValidity(i));
