@@ -1183,3 +1183,184 @@ TEST(InverseSensorModel, FloorOffsetIsMeasuredWithoutTheFloorNoise)
 	EXPECT_EQ(tauWith(true, false), -1.0);
 	EXPECT_EQ(tauWith(false, false), -1.0);
 }
+
+namespace
+{
+// range_smear. A camera with a flat 3 cm range sigma (custom time-of-flight
+// c0 = 0.03) at (0, 0, 0.5) over the floor z = 0. A wall cell W at x = 4.075
+// holds 300 samples from 0.1 to 0.5 m; the cell V in front of it (x = 4.025)
+// holds 20 floor samples and `inFront` samples of the same heights. Both
+// cells reach z = 0.5 = the sensor's height, so the rays are level: slant
+// range r = rho and the horizontal sigma is sigma = 0.03 itself.
+// By hand: a surface at W's centre leaves stay = 2 Phi(0.025 / 0.03) - 1 =
+// 2 x 0.7976716 - 1 = 0.5953432 of its samples in W and moves Phi((0.05 +
+// 0.025) / 0.03) - Phi((0.05 - 0.025) / 0.03) = 0.9937903 - 0.7976716 =
+// 0.1961187 of them into V (centres 5 cm apart): lambda = 300 x 0.1961187 /
+// 0.5953432 = 98.826, and with 3 Poisson deviations 98.826 + 3 sqrt(98.826)
+// = 128.65. V's samples above the band are W's if there are at most 128.
+constexpr double kSmearV = 4.025, kSmearW = 4.075, kSmearY = 0.025;
+ElevationGrid smearFrame(int inFront, BinnedPoints& b, double wallX = kSmearW, bool floorBetween = false)
+{
+	ElevationGrid grid;
+	b.clear();
+	for (int i = 0; i < 300; i++) grid.binPoint(wallX, kSmearY, float(0.1 + 0.4 * i / 299.0), b);
+	for (int i = 0; i < 20; i++) grid.binPoint(kSmearV, kSmearY, 0.f, b);
+	for (int i = 0; i < inFront; i++)
+		grid.binPoint(kSmearV, kSmearY, float(inFront > 1 ? 0.1 + 0.4 * i / (inFront - 1) : 0.5), b);
+	if (floorBetween)
+		for (int i = 0; i < 20; i++) grid.binPoint(0.5 * (kSmearV + wallX), kSmearY, 0.f, b);
+	grid.insert(b, OutlierFilterParams{});
+	return grid;
+}
+CameraNoise flatNoise(double sigma)
+{
+	CameraNoise n;
+	n.tof_c0 = sigma;
+	return n;
+}
+}  // namespace
+
+TEST(InverseSensorModel, AWallsSamplesPushedTowardTheCameraGiveNoObstacleInFrontOfIt)
+{
+	const double lambda =
+		300.0 * (ism::normalTail(-2.5) - ism::normalTail(-0.025 / 0.03)) / (2.0 * ism::normalTail(-0.025 / 0.03) - 1.0);
+	EXPECT_NEAR(lambda, 98.826, 1e-3);
+	EXPECT_NEAR(lambda + 3.0 * std::sqrt(lambda), 128.65, 1e-2);
+	IsmParams p;
+	ASSERT_TRUE(p.range_smear);
+	ASSERT_EQ(p.noise_sigmas, 3.0);
+	InverseSensorModel ism(p);
+	ism.setCameraNoise(flatNoise(0.03), 500);
+	IsmStats st;
+	BinnedPoints b;
+	const Eigen::Vector3d sensor{0, 0, 0.5};
+	const auto cellAt = [](const ElevationGrid& f, double x) {
+		return uint32_t(f.geometry().index(f.geometry().ix(x), f.geometry().iy(kSmearY)));
+	};
+	const ElevationGrid f128 = smearFrame(128, b);
+	ism.compute(f128, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_EQ(ism.classes()[cellAt(f128, kSmearV)], VoxelClass::Obstacle);
+	EXPECT_EQ(ism.evidence()[cellAt(f128, kSmearV)], 0.5f) << "128 <= 128.65: the wall's samples";
+	EXPECT_GT(ism.evidence()[cellAt(f128, kSmearW)], 0.5f) << "the wall itself";
+	EXPECT_EQ(st.smeared, 1u);
+	EXPECT_EQ(st.obstacle, 1u);
+	checkEvidenceBookkeeping(ism);
+
+	const ElevationGrid f129 = smearFrame(129, b);
+	ism.compute(f129, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_GT(ism.evidence()[cellAt(f129, kSmearV)], 0.5f) << "129 > 128.65: more than the wall's noise explains";
+	EXPECT_EQ(st.smeared, 0u);
+	EXPECT_EQ(st.obstacle, 2u);
+
+	// Off: every such cell counts.
+	IsmParams off = p;
+	off.range_smear = false;
+	InverseSensorModel noRule(off);
+	noRule.setCameraNoise(flatNoise(0.03), 500);
+	noRule.compute(f128, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_GT(noRule.evidence()[cellAt(f128, kSmearV)], 0.5f);
+	EXPECT_EQ(st.smeared, 0u);
+
+	// Floor seen between them (the wall a cell farther, x = 4.125): a separate
+	// object. The walk (up to 3 sigma + half a cell = 0.115 m, in half cells)
+	// meets the floor cell at 4.075 first.
+	const ElevationGrid gap = smearFrame(60, b, 4.125, true);
+	ism.compute(gap, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_EQ(ism.classes()[cellAt(gap, 4.075)], VoxelClass::Ground);
+	EXPECT_GT(ism.evidence()[cellAt(gap, kSmearV)], 0.5f);
+	EXPECT_EQ(st.smeared, 0u);
+	// Without that floor the same 60 are the wall's (a cell between unseen;
+	// centres 0.1 m apart: Phi(0.125 / 0.03) - Phi(0.075 / 0.03) = 0.0062 of
+	// the wall's samples, lambda = 300 x 0.0062 / 0.5953 = 3.1, bound 8.4):
+	// no, 60 > 8.4, they count.
+	const ElevationGrid far = smearFrame(60, b, 4.125);
+	ism.compute(far, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_GT(ism.evidence()[cellAt(far, kSmearV)], 0.5f);
+	const ElevationGrid farFew = smearFrame(8, b, 4.125);
+	ism.compute(farFew, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_EQ(ism.evidence()[cellAt(farFew, kSmearV)], 0.5f) << "8 <= 8.4";
+
+	// A low object's top spread over both cells is as dense in each: a wall
+	// cell of 20 samples (lambda = 20 x 0.1961187 / 0.5953432 = 6.588, bound
+	// 6.588 + 3 sqrt(6.588) = 14.29) and 12 in front of it. 12 <= 14.29, but
+	// 12 > 20 - 3 sqrt(20) = 6.58: not clearly fewer than the cell behind
+	// holds, so they count; 6 of them would not.
+	const auto lowTop = [&](int inFront) {
+		ElevationGrid grid;
+		b.clear();
+		for (int i = 0; i < 20; i++) grid.binPoint(kSmearW, kSmearY, float(0.1 + 0.4 * i / 19.0), b);
+		for (int i = 0; i < 20; i++) grid.binPoint(kSmearV, kSmearY, 0.f, b);
+		for (int i = 0; i < inFront; i++) grid.binPoint(kSmearV, kSmearY, float(0.1 + 0.4 * i / (inFront - 1)), b);
+		grid.insert(b, OutlierFilterParams{});
+		return grid;
+	};
+	EXPECT_NEAR(20.0 - 3.0 * std::sqrt(20.0), 6.58, 1e-2);
+	const ElevationGrid dense = lowTop(12);
+	ism.compute(dense, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_GT(ism.evidence()[cellAt(dense, kSmearV)], 0.5f) << "12 > 6.58";
+	EXPECT_EQ(st.smeared, 0u);
+	const ElevationGrid sparse = lowTop(6);
+	ism.compute(sparse, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_EQ(ism.evidence()[cellAt(sparse, kSmearV)], 0.5f) << "6 <= 6.58 and <= 14.29";
+	EXPECT_EQ(st.smeared, 1u);
+
+	// A camera whose 3 sigma stays under a cell (3 mm: 3 sigma + half a cell
+	// = 0.034 m < the next cell's 0.05): the rule never looks.
+	InverseSensorModel fine(p);
+	fine.setCameraNoise(flatNoise(0.003), 500);
+	fine.compute(f128, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_GT(fine.evidence()[cellAt(f128, kSmearV)], 0.5f);
+	EXPECT_EQ(st.smeared, 0u);
+}
+
+TEST(InverseSensorModel, AStepDownsSamplesPushedAwayGiveNoDropBeyondItsEdge)
+{
+	// The mirror case: the face of a step down (a drop cell W at x = 4.025,
+	// 300 samples from -0.3 to -0.05) and the floor beyond its edge (V at
+	// 4.075: 20 floor samples and `beyond` samples at the face's depths),
+	// seen from (0, 0, 1). V's ray: rho = 4.075077, its deepest sample 1.3 m
+	// below the sensor, r = sqrt(4.075077^2 + 1.3^2) = 4.277412; sigma = 0.03
+	// gives 0.03 x 4.075077 / 4.277412 = 0.028581 horizontally and W (5 cm
+	// nearer) moves Phi(0.075 / 0.028581) - Phi(0.025 / 0.028581) = 0.995656
+	// - 0.809134 = 0.186522 of its samples into V and keeps 2 x 0.809134 - 1 =
+	// 0.618268: lambda = 300 x 0.186522 / 0.618268 = 90.506, bound 90.506 + 3
+	// sqrt(90.506) = 119.05.
+	const double rho = std::hypot(4.075, 0.025), r = std::hypot(rho, 1.3), s2 = 0.03 * rho / r;
+	EXPECT_NEAR(r, 4.277412, 1e-6);
+	EXPECT_NEAR(s2, 0.028581, 1e-6);
+	const double stay = 1.0 - 2.0 * ism::normalTail(0.025 / s2);
+	const double lambda = 300.0 * (ism::normalTail(0.025 / s2) - ism::normalTail(0.075 / s2)) / stay;
+	EXPECT_NEAR(stay, 0.618268, 1e-6);
+	EXPECT_NEAR(lambda, 90.506, 1e-3);
+	EXPECT_NEAR(lambda + 3.0 * std::sqrt(lambda), 119.05, 1e-2);
+	const auto frame = [](int beyond, BinnedPoints& b) {
+		ElevationGrid grid;
+		b.clear();
+		for (int i = 0; i < 300; i++) grid.binPoint(4.025, kSmearY, float(-0.3 + 0.25 * i / 299.0), b);
+		for (int i = 0; i < 20; i++) grid.binPoint(4.075, kSmearY, 0.f, b);
+		for (int i = 0; i < beyond; i++) grid.binPoint(4.075, kSmearY, float(-0.3 + 0.25 * i / (beyond - 1)), b);
+		grid.insert(b, OutlierFilterParams{});
+		return grid;
+	};
+	IsmParams p;
+	p.drop_rays = false;  // the drop cells' own evidence only
+	InverseSensorModel ism(p);
+	ism.setCameraNoise(flatNoise(0.03), 500);
+	IsmStats st;
+	BinnedPoints b;
+	const Eigen::Vector3d sensor{0, 0, 1};
+	const ElevationGrid f119 = frame(119, b);
+	const uint32_t v = uint32_t(f119.geometry().index(f119.geometry().ix(4.075), f119.geometry().iy(kSmearY)));
+	const uint32_t w = uint32_t(f119.geometry().index(f119.geometry().ix(4.025), f119.geometry().iy(kSmearY)));
+	ism.compute(f119, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_GT(ism.evidence()[w], 0.5f) << "the face";
+	EXPECT_EQ(ism.evidence()[v], 0.5f) << "119 <= 119.05: the face's samples";
+	EXPECT_EQ(st.smeared, 1u);
+	EXPECT_EQ(st.drop, 1u);
+	const ElevationGrid f120 = frame(120, b);
+	ism.compute(f120, handDetection(kFloor), sensor, 5.0, st, &b);
+	EXPECT_GT(ism.evidence()[v], 0.5f) << "120 > 119.05";
+	EXPECT_EQ(st.smeared, 0u);
+	EXPECT_EQ(st.drop, 2u);
+	checkEvidenceBookkeeping(ism);
+}

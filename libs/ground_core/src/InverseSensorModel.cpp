@@ -272,7 +272,71 @@ bool InverseSensorModel::rayBlocked(
 	return false;
 }
 
-void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats)
+bool InverseSensorModel::smeared(
+	const ElevationGrid& frame, uint32_t cell, uint32_t beyond, bool drop, const Eigen::Vector3d& sensor) const
+{
+	const GridGeometry& g = frame.geometry();
+	const ElevationCell& v = frame.cell(cell);
+	const int cx = int(cell % uint32_t(g.nx)), cy = int(cell / uint32_t(g.nx));
+	const double x = g.cx(cx), y = g.cy(cy);
+	const double zv = drop ? v.z_min : v.z_max;  // its extreme sample
+	const double dx = x - sensor.x(), dy = y - sensor.y(), dz = zv - sensor.z();
+	const double rho = std::sqrt(dx * dx + dy * dy);
+	if (!(rho > 0)) return false;
+	// One sample's range sigma at this slant range, both parts (taking the
+	// slant range for the depth overstates it by at most 1 / cos of the
+	// half field of view), and its horizontal and vertical shares.
+	const double r = std::sqrt(rho * rho + dz * dz);
+	const double sigma = std::hypot(m_camera.independent(r, m_fx), m_camera.correlated(r, m_fx));
+	const double k = m_params.noise_sigmas, reach = k * sigma;
+	const double sigma2d = sigma * rho / r, reach2d = reach * rho / r, rise = reach * std::abs(dz) / r;
+	const double res = g.resolution, step = 0.5 * res;
+	if (!(sigma2d > 0) || reach2d + step < res) return false;  // it never reaches the next cell
+	// Of a surface's samples at a cell's centre, the share its range noise
+	// leaves in that cell, and the share it moves into a cell d away.
+	const auto phi = [](double u) { return 0.5 * std::erfc(-u / std::sqrt(2.0)); };
+	double stay = -1;  // computed at the first candidate cell
+	// An obstacle's samples come toward the sensor, in front of its face; a
+	// drop's (the face of a step down, a hole's far wall) go away from it,
+	// into the floor beyond its edge.
+	const double sign = drop ? -1.0 : 1.0;
+	const double ux = sign * dx / rho, uy = sign * dy / rho;
+	const VoxelClass same = drop ? VoxelClass::Drop : VoxelClass::Obstacle;
+	uint32_t last = cell;
+	for (double t = res; t <= reach2d + step + 1e-9; t += step)
+	{
+		const int qx = g.ix(x + t * ux), qy = g.iy(y + t * uy);
+		if (!g.inside(qx, qy)) return false;
+		const uint32_t q = uint32_t(g.index(qx, qy));
+		if (q == last) continue;
+		last = q;
+		const VoxelClass qc = m_class[q];
+		if (qc == VoxelClass::None) continue;  // not seen in this frame: look on
+		if (qc != same) return false;          // anything else between them: a separate object
+		const ElevationCell& w = frame.cell(q);
+		// As high (deep) as this cell's extreme sample, less the vertical share
+		// of the displacement.
+		if (drop ? w.z_min - rise > v.z_min : w.z_max + rise < v.z_max) continue;
+		const uint32_t wBeyond = m_tailCell[q] ? m_tailCount[q] : w.count;
+
+		// This cell's samples are that cell's if they are no more than its
+		// noise puts here (expected lambda, and noise_sigmas Poisson
+		// deviations above it) and clearly fewer than it holds (noise_sigmas
+		// deviations below): a low object's top spread over a few cells is
+		// as dense in each, a wall's samples in front of it are not.
+		const double n = double(beyond), nw = double(wBeyond);
+		if (n > nw - k * std::sqrt(nw)) continue;
+		const double d = std::hypot(g.cx(qx) - x, g.cy(qy) - y);
+		if (stay < 0) stay = 2.0 * phi(0.5 * res / sigma2d) - 1.0;
+		const double moved = phi((d + 0.5 * res) / sigma2d) - phi((d - 0.5 * res) / sigma2d);
+		const double lambda = nw * moved / stay;
+		if (n <= lambda + k * std::sqrt(lambda)) return true;
+	}
+	return false;
+}
+
+void InverseSensorModel::countTailSamples(
+	const ElevationGrid& frame, const BinnedPoints& samples, const Eigen::Vector3d& sensor, IsmStats& stats)
 {
 	// One pass over the frame's samples: each candidate cell counts those
 	// below its low threshold or above its high one that the 3-sigma rule
@@ -293,25 +357,18 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 	}
 	const double alpha = ism::normalTail(m_params.noise_sigmas);
 	const uint32_t minRay = uint32_t(std::max(1, m_params.drop_ray_min_points));
-	const double res = frame.geometry().resolution;
+	const bool smear = smearTest();
+	// The counts stay until clearTailCandidates(): range_smear reads them.
 	for (const TailCandidate& d : m_tailCandidates)
 	{
 		const uint32_t k = m_tailCount[d.cell];
-		m_tailLo[d.cell] = -std::numeric_limits<float>::infinity();
-		m_tailHi[d.cell] = std::numeric_limits<float>::infinity();
-		m_tailCount[d.cell] = 0;
-		m_tailCell[d.cell] = 0;
 		const ElevationCell& c = frame.cell(d.cell);
-		const float pOcc = obstacleEvidence(c, res);
 		if (d.kind == TailKind::Deep)
 		{
 			if (k < minRay || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
+			// Its ground evidence stays if range_smear takes this back.
 			m_class[d.cell] = VoxelClass::Drop;
-			stats.ground--;
-			stats.drop++;
-			stats.deep_drops++;
-			put(d.cell, pOcc);
-			if (m_params.drop_rays) m_dropVoxels.push_back(d.cell);
+			hold(Held{d.cell, k, true, m_params.drop_rays, true}, smear, frame, stats);
 			continue;
 		}
 		// An obstacle or a drop judged by its extreme sample: it takes as many
@@ -323,9 +380,38 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 			stats.sparse++;
 			continue;
 		}
-		(drop ? stats.drop : stats.obstacle)++;
-		put(d.cell, pOcc);
-		if (drop && m_params.drop_rays && k >= minRay) m_dropVoxels.push_back(d.cell);
+		hold(Held{d.cell, k, drop, drop && m_params.drop_rays && k >= minRay, false}, smear, frame, stats);
+	}
+}
+
+void InverseSensorModel::hold(const Held& h, bool smear, const ElevationGrid& frame, IsmStats& stats)
+{
+	if (smear)
+		m_held.push_back(h);
+	else
+		give(h, frame, stats);
+}
+
+void InverseSensorModel::give(const Held& h, const ElevationGrid& frame, IsmStats& stats)
+{
+	if (h.deep)
+	{
+		stats.ground--;
+		stats.deep_drops++;
+	}
+	(h.drop ? stats.drop : stats.obstacle)++;
+	put(h.cell, obstacleEvidence(frame.cell(h.cell), frame.geometry().resolution));
+	if (h.ray) m_dropVoxels.push_back(h.cell);
+}
+
+void InverseSensorModel::clearTailCandidates()
+{
+	for (const TailCandidate& d : m_tailCandidates)
+	{
+		m_tailLo[d.cell] = -std::numeric_limits<float>::infinity();
+		m_tailHi[d.cell] = std::numeric_limits<float>::infinity();
+		m_tailCount[d.cell] = 0;
+		m_tailCell[d.cell] = 0;
 	}
 	m_tailCandidates.clear();
 }
@@ -356,6 +442,7 @@ void InverseSensorModel::compute(
 		m_offsetValue.reserve(g.cellCount());
 		m_offsetSorted.reserve(g.cellCount());
 		m_tailCandidates.reserve(g.cellCount());
+		m_held.reserve(g.cellCount());
 		m_tailLo.assign(g.cellCount(), -std::numeric_limits<float>::infinity());
 		m_tailHi.assign(g.cellCount(), std::numeric_limits<float>::infinity());
 		m_tailCount.assign(g.cellCount(), 0);
@@ -382,7 +469,9 @@ void InverseSensorModel::compute(
 	const bool deepTest = m_params.deep_sample_test && haveSamples && m_params.noise_sigmas > 0;
 	// Whether the camera's samples share part of their error (see the deep-sample test).
 	const bool sharedNoise = m_camera.correlated(1.0, m_fx) > 0;
+	const bool smear = smearTest();
 	m_tailCandidates.clear();
+	m_held.clear();
 
 	// Pass 1: every observed voxel updates its own cell.
 	for (uint32_t idx : frame.observedCells())
@@ -467,11 +556,13 @@ void InverseSensorModel::compute(
 					break;
 				}
 				if (deferred) break;
-				(cls == VoxelClass::Drop ? stats.drop : stats.obstacle)++;
-				put(idx, obstacleEvidence(c, res));
-				if (cls == VoxelClass::Drop && m_params.drop_rays &&
-					c.count >= uint32_t(std::max(1, m_params.drop_ray_min_points)))
-					m_dropVoxels.push_back(idx);
+				const bool drop = cls == VoxelClass::Drop;
+				hold(
+					Held{
+						idx, c.count, drop,
+						drop && m_params.drop_rays && c.count >= uint32_t(std::max(1, m_params.drop_ray_min_points)),
+						false},
+					smear, frame, stats);
 				break;
 			}
 			case VoxelClass::Overhead: stats.overhead++; break;
@@ -483,7 +574,22 @@ void InverseSensorModel::compute(
 	// The tail count's list, sized with the samples' buffer on every frame (a
 	// later frame then allocates nothing, candidates or not).
 	if (samples && m_tailSamples.size() < samples->capacity()) m_tailSamples.resize(samples->capacity());
-	if (!m_tailCandidates.empty()) countTailSamples(frame, *samples, stats);
+	if (!m_tailCandidates.empty()) countTailSamples(frame, *samples, sensor, stats);
+	// range_smear: every class and count of the frame is known now. Judge
+	// all held cells first, then give evidence (no verdict reads another).
+	for (Held& h : m_held) h.smeared = smeared(frame, h.cell, h.beyond, h.drop, sensor);
+	for (const Held& h : m_held)
+	{
+		if (!h.smeared)
+			give(h, frame, stats);
+		else
+		{
+			stats.smeared++;
+			if (h.deep) m_class[h.cell] = VoxelClass::Ground;  // it stays the floor it was judged
+		}
+	}
+	m_held.clear();
+	clearTailCandidates();
 
 	// Pass 2: the ray to a below-ground voxel crossed the ground plane and went
 	// on below it; no floor stopped it in between. Mark those cells, unless

@@ -78,6 +78,28 @@ struct IsmParams
 	 * drop_ray_min_points (a depth spike is not a hole). Off: the cell's
 	 * z_min and mean only. */
 	bool deep_sample_test = true;
+	/** A surface's samples moved along their rays by the range noise
+	 * (issue #27). A depth sample's error lies along its ray: a wall at range
+	 * r whose samples scatter by sigma(r) puts some of them into the floor
+	 * cells in front of it, up to noise_sigmas * sigma(r) away (an
+	 * active-stereo or structured-light camera: 10-15 cm at 4-5 m), and the
+	 * face of a step down puts some into the floor beyond its edge. An
+	 * obstacle (drop) cell gives no evidence when, along its ray from the
+	 * sensor (toward the sensor, for a drop) and within noise_sigmas * sigma
+	 * of its range plus half a cell (sigma from the camera's noise model, both
+	 * parts; horizontally sigma rho / r), a cell of the same class, with
+	 * nothing but unseen cells between them, reaches as high (deep), less the
+	 * vertical share of that move, and explains its samples beyond the band:
+	 * they are no more than that cell's noise puts there (n_w * moved / stay,
+	 * plus noise_sigmas Poisson deviations; moved and stay from the normal
+	 * distribution of the move, cell centres d apart) and clearly fewer than
+	 * that cell holds (n_w - noise_sigmas sqrt(n_w)), so that a low object's
+	 * top spread over a few cells keeps them all. Only cells whose centres
+	 * are at least a cell apart are compared: a camera whose reach stays
+	 * under half a cell changes nothing (3 sigma < 8.3 mm: the Kinect One
+	 * nearer than 5.7 m, the Femto nearer than 3.9 m). Off: every such cell
+	 * counts. */
+	bool range_smear = true;
 	/** Bumps and dips smaller than this are floor for the robot: its wheels
 	 * cross them (the simulator's ground truth uses the same 2 cm). The band
 	 * of the mean never gets narrower. [m] */
@@ -154,6 +176,12 @@ struct IsmParams
 				"deep_sample_test", 0, 1,
 				"a cell with more samples far below the plane than floor noise explains is a drop"},
 			p.deep_sample_test);
+		visit(
+			ParamInfo{
+				"range_smear", 0, 1,
+				"a floor cell with a few samples above it, within the range noise in front of a taller obstacle "
+				"along its ray, gives no evidence (the obstacle's samples)"},
+			p.range_smear);
 		visit(
 			ParamInfo{"traversable_step", 0, 1, "bumps and dips smaller than this are floor for the robot [m]"},
 			p.traversable_step);
@@ -287,7 +315,8 @@ struct IsmStats
 	size_t drop_ray_cells = 0;
 	size_t drop_rays_unsupported = 0;  ///< drop rays not cast: an obstacle stood between the sensor and the crossing
 	size_t deep_drops = 0;             ///< drops found by the deep-sample count alone
-	bool applied = false;              ///< false when there was no ground plane
+	size_t smeared = 0;    ///< obstacle / drop cells whose samples beyond the band are another cell's (range_smear)
+	bool applied = false;  ///< false when there was no ground plane
 };
 
 /** Where ramp or landing patches (planes[k], k >= 1) applied in an
@@ -415,7 +444,33 @@ class InverseSensorModel
 	 * decides it: deep_sample_test (a floor cell becomes a drop), or an
 	 * obstacle / drop judged by its extreme sample (min_obstacle_points of
 	 * them beyond the band give evidence, drop_ray_min_points cast a ray). */
-	void countTailSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats);
+	void countTailSamples(
+		const ElevationGrid& frame, const BinnedPoints& samples, const Eigen::Vector3d& sensor, IsmStats& stats);
+	/** range_smear: whether the `beyond` samples above (below, `drop`) the
+	 * band of the obstacle (drop) cell `cell` can be those of a cell of the
+	 * same class farther along its ray (nearer, for a drop), within
+	 * noise_sigmas of the camera's range noise. Reads the frame's classes and
+	 * the tail candidates' counts, so it runs after countTailSamples. */
+	bool smeared(
+		const ElevationGrid& frame, uint32_t cell, uint32_t beyond, bool drop, const Eigen::Vector3d& sensor) const;
+	/** An obstacle or drop cell about to give evidence: its samples beyond
+	 * the band, what it is, whether it casts a drop ray, whether the
+	 * deep-sample test made it a drop; range_smear's verdict. */
+	struct Held
+	{
+		uint32_t cell;
+		uint32_t beyond;
+		bool drop, ray, deep;
+		bool smeared = false;
+	};
+	/** Gives the evidence now, or holds the cell for range_smear. */
+	void hold(const Held& h, bool smear, const ElevationGrid& frame, IsmStats& stats);
+	/** Puts an obstacle or drop cell's evidence (and its drop ray). */
+	void give(const Held& h, const ElevationGrid& frame, IsmStats& stats);
+	/** Whether range_smear applies (on, a noise model, a focal length). */
+	bool smearTest() const { return m_params.range_smear && m_params.noise_sigmas > 0 && m_fx > 0; }
+	/** Resets the tail candidates' scratch tables (after range_smear). */
+	void clearTailCandidates();
 	void measureFloorNoise(const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor);
 
 	std::vector<float> m_floorNoise;   ///< per bin: measured std [m], < 0 = not measured
@@ -451,6 +506,7 @@ class InverseSensorModel
 		bool onPatch;  ///< judged against a ramp or landing patch (minPoints)
 	};
 	std::vector<TailCandidate> m_tailCandidates;
+	std::vector<Held> m_held;  ///< obstacle and drop cells waiting for range_smear
 	std::vector<float> m_tailLo, m_tailHi;
 	std::vector<uint32_t> m_tailCount;
 	std::vector<uint8_t> m_tailCell;      ///< 1 for the tail candidates' cells (during countTailSamples)
