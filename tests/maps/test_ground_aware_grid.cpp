@@ -413,6 +413,31 @@ TEST(GroundAwareGrid, LeddarRaysInACorridorEndOnBothWalls)
 			EXPECT_NEAR(r, wallRange(a), 0.02) << "ray " << o << " of segment " << seg;
 		}
 	}
+	// The concave corners (the side walls end at atan(1.435 / 7.8) = 10.424
+	// deg, in segments 4 and 11). Segment 4 (cone -12..-9 deg, echo 6.9020 m
+	// on the side wall at -12) recedes toward segment 5 (7.8430 m: the end
+	// wall at -6 deg), a local maximum of the ranges (segment 6: 7.8107 m).
+	// The side wall's line, through segment 3's echo (5.5444 m at -15 deg)
+	// and segment 4's, meets segment 5's direction (-9 deg) at 1.435 / sin 9
+	// = 9.173 m, behind 7.8430: a corner. Segment 4's rays end on the side
+	// wall (its line, exact on the wall) but no farther than 7.8430 m: its
+	// rays at -11.8125 .. -10.6875 deg on the wall, 7.0099 .. 7.7378 m; those
+	// past the corner (-10.3125 .. -9.1875 deg, the end wall 7.8/cos: 7.9281
+	// .. 7.9014 m) at 7.8430 m, 8.5 .. 5.8 cm in front of it. The chord from
+	// (6.9020 m, -12 deg) to (7.8430 m, -9 deg) cut the corner: the ray at
+	// -10.3125 deg ended on it at 7.399 m, 53 cm in front of the end wall.
+	for (size_t j = 0; j < 8; j++)
+	{
+		const double a = DEG2RAD(upsampledRayDeg(32 + j)), r = up.getScanRange(32 + j);
+		if (j < 4)
+			EXPECT_NEAR(r, wallRange(a), 0.002) << "segment 4, ray " << j << ": on the side wall";
+		else
+		{
+			EXPECT_NEAR(r, 7.8430, 0.0005) << "segment 4, ray " << j << ": at segment 5's echo";
+			EXPECT_LT(wallRange(a) - r, 0.086);
+		}
+	}
+	EXPECT_NEAR(wallRange(DEG2RAD(upsampledRayDeg(36))), 7.9281, 1e-4);
 	// As an arc, segment 0 (echo 1.435 / sin 24 = 3.528 m) ended its inner
 	// ray (21.1875 deg, the wall 1.435 / sin 21.1875 = 3.970 m away) 44 cm
 	// in front of the wall.

@@ -331,11 +331,17 @@ mrpt::obs::CObservation2DRangeScan CGroundAwareOccupancyGrid::upsampleSparseScan
 		// 24 deg) facing a wall 5.8 m away, 5.8 (1 - cos 24 / cos 21).
 		// Elsewhere (a nearest point inside the cone: a pole, the foot of the
 		// perpendicular; no neighbour echo; a jump that no surface at more
-		// than kMinIncidence from the rays makes): the arc. (A concave corner
-		// in the neighbour's cone can put the chord in front of the corner;
-		// two checks for it were tried and marked more floor on the 27 scenes,
-		// D435 1176 -> 1215 and -> 1191 cells: see doc/benchmark.md.)
-		double ax = 0, ay = 0, bx = 0, by = 0;
+		// than kMinIncidence from the rays makes): the arc.
+		// A concave corner: where this segment's surface, extended (the line
+		// through the nearer neighbour's echo and this one's, both at their
+		// near edges), passes behind the farther neighbour's echo, a second
+		// surface meets it inside the cones, and the chord would cut the
+		// corner. There the rays end on that line but no farther than the
+		// neighbour's echo: the nearer of the two surfaces, as seen from
+		// inside a corner. (Two earlier checks for such corners kept the arc
+		// instead and marked more floor on the 27 scenes, D435 1176 -> 1215
+		// and -> 1191 cells: see doc/benchmark.md.)
+		double ax = 0, ay = 0, bx = 0, by = 0, cap = 0;
 		bool chord = false;
 		if (nearEdge && valid(i) && N > 1)
 		{
@@ -348,6 +354,26 @@ mrpt::obs::CObservation2DRangeScan CGroundAwareOccupancyGrid::upsampleSparseScan
 				x = range(seg) * std::cos(a);
 				y = range(seg) * std::sin(a);
 			};
+			// The concave-corner test for a segment receding from `nearer` (itself
+			// receding from `nearer2`, so its echo is at its near edge too)
+			// toward `farther`; `edge` is the near edges' side.
+			const auto corner = [&](size_t nearer, size_t nearer2, size_t farther, double edge) {
+				if (!valid(nearer) || !valid(nearer2) || !(range(nearer2) < range(nearer))) return;
+				double px = 0, py = 0;
+				at(nearer, edge, px, py);
+				const double lx = px - ax, ly = py - ay;
+				// This surface extended, at the farther neighbour's echo direction.
+				const double a = centre(farther) + edge;
+				const double den = std::cos(a) * ly - std::sin(a) * lx;
+				if (!(std::abs(den) > 0)) return;
+				const double t = (ax * ly - ay * lx) / den;
+				if (t > range(farther))
+				{
+					bx = px;
+					by = py;
+					cap = range(farther);
+				}
+			};
 			if (!prevFarther && !nextNearer && (i == 0 || valid(i - 1)) && (nextFarther || prevNearer))
 			{
 				// Receding toward i + 1: each echo is at its cone's edge toward
@@ -356,12 +382,14 @@ mrpt::obs::CObservation2DRangeScan CGroundAwareOccupancyGrid::upsampleSparseScan
 				at(i, -0.5 * cone, ax, ay);
 				at(nextFarther ? i + 1 : i - 1, -0.5 * cone, bx, by);
 				chord = true;
+				if (nextFarther && prevNearer && i >= 2) corner(i - 1, i - 2, i + 1, -0.5 * cone);
 			}
 			else if (!nextFarther && !prevNearer && (i + 1 == N || valid(i + 1)) && (prevFarther || nextNearer))
 			{
 				at(i, 0.5 * cone, ax, ay);
 				at(prevFarther ? i - 1 : i + 1, 0.5 * cone, bx, by);
 				chord = true;
+				if (prevFarther && nextNearer && i + 2 < N) corner(i + 1, i + 2, i - 1, 0.5 * cone);
 			}
 		}
 		// The ray (cos a, sin a) t meets A + (B - A) u where
@@ -375,7 +403,14 @@ mrpt::obs::CObservation2DRangeScan CGroundAwareOccupancyGrid::upsampleSparseScan
 			{
 				const double a = centre(i) - 0.5 * s + (j + 0.5) * s / k;
 				const double den = std::cos(a) * dy - std::sin(a) * dx;
-				if (len > 0 && std::abs(den) >= len * std::sin(kMinIncidence)) ro = std::max(r, cross / den);
+				if (cap > 0)
+				{
+					// Parallel to the ray, or met behind the sensor: the cap alone.
+					const double t = std::abs(den) > 0 ? cross / den : 0;
+					ro = std::max(r, t > 0 ? std::min(t, cap) : cap);
+				}
+				else if (len > 0 && std::abs(den) >= len * std::sin(kMinIncidence))
+					ro = std::max(r, cross / den);
 			}
 			out.setScanRange(o, float(ro));
 			out.setScanRangeValidity(o, in.getScanRangeValidity(i));
