@@ -317,6 +317,10 @@ mrpt::obs::CObservation2DRangeScan CGroundAwareOccupancyGrid::upsampleSparseScan
 	// A beam's own cone: its beamAperture where the scan gives one (the
 	// simulated Leddar's 2.8125 deg segments sit 3 deg apart), else the spacing.
 	const double cone = in.beamAperture > 0 && double(in.beamAperture) < s ? double(in.beamAperture) : s;
+	// How far from a line three echoes of one flat surface may lie: 3 sigma of
+	// the scan's range noise (the Leddar IS16's 2.5 cm when the scan does
+	// not say).
+	const double straight = 3.0 * (in.stdError > 0 ? double(in.stdError) : 0.025);
 	for (size_t i = 0; i < N; i++)
 	{
 		const double r = range(i);
@@ -359,9 +363,14 @@ mrpt::obs::CObservation2DRangeScan CGroundAwareOccupancyGrid::upsampleSparseScan
 			// toward `farther`; `edge` is the near edges' side.
 			const auto corner = [&](size_t nearer, size_t nearer2, size_t farther, double edge) {
 				if (!valid(nearer) || !valid(nearer2) || !(range(nearer2) < range(nearer))) return;
-				double px = 0, py = 0;
+				double px = 0, py = 0, qx = 0, qy = 0;
 				at(nearer, edge, px, py);
-				const double lx = px - ax, ly = py - ay;
+				at(nearer2, edge, qx, qy);
+				const double lx = px - ax, ly = py - ay, ll = std::hypot(lx, ly);
+				// One straight surface over three cones: the third echo within
+				// 3 sigma of the scan's range noise of the line (else the line
+				// may run behind what this cone saw).
+				if (!(ll > 0) || std::abs(lx * (qy - ay) - ly * (qx - ax)) / ll > straight) return;
 				// This surface extended, at the farther neighbour's echo direction.
 				const double a = centre(farther) + edge;
 				const double den = std::cos(a) * ly - std::sin(a) * lx;
