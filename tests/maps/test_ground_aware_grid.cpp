@@ -438,6 +438,15 @@ TEST(GroundAwareGrid, LeddarRaysInACorridorEndOnBothWalls)
 		}
 	}
 	EXPECT_NEAR(wallRange(DEG2RAD(upsampledRayDeg(36))), 7.9281, 1e-4);
+	// Only on one straight surface: with segment 2's echo (at -18 deg) moved
+	// from 4.6438 to 4.2 m, it lies 0.4438 x sin 18 deg = 0.137 m off the
+	// side wall, on which segments 3's and 4's echoes lie: more than 3 x
+	// 0.025 m (the scan's default range sigma) off their line. Segment 4
+	// keeps its chord: 7.399 m at -10.3125 deg.
+	auto bent = s;
+	bent.setScanRange(2, 4.2f);
+	const auto upBent = CGroundAwareOccupancyGrid::upsampleSparseScan(bent, 8);
+	EXPECT_NEAR(upBent.getScanRange(36), 7.399, 0.001);
 	// As an arc, segment 0 (echo 1.435 / sin 24 = 3.528 m) ended its inner
 	// ray (21.1875 deg, the wall 1.435 / sin 21.1875 = 3.970 m away) 44 cm
 	// in front of the wall.
