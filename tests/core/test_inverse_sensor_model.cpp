@@ -1283,8 +1283,9 @@ TEST(InverseSensorModel, AWallsSamplesPushedTowardTheCameraGiveNoObstacleInFront
 	// A low object's top spread over both cells is as dense in each: a wall
 	// cell of 20 samples (lambda = 20 x 0.1961187 / 0.5953432 = 6.588, bound
 	// 6.588 + 3 sqrt(6.588) = 14.29) and 12 in front of it. 12 <= 14.29, but
-	// 12 > 20 - 3 sqrt(20) = 6.58: not clearly fewer than the cell behind
-	// holds, so they count; 6 of them would not.
+	// 12 is nearer 20 than 6.588 in Poisson deviations: (12 - 6.588) /
+	// sqrt(6.588) = 2.109 > (20 - 12) / sqrt(20) = 1.789: a surface of its
+	// own, so they count. 6 of them: 0.229 < 3.130, the wall's.
 	const auto lowTop = [&](int inFront) {
 		ElevationGrid grid;
 		b.clear();
@@ -1294,14 +1295,15 @@ TEST(InverseSensorModel, AWallsSamplesPushedTowardTheCameraGiveNoObstacleInFront
 		grid.insert(b, OutlierFilterParams{});
 		return grid;
 	};
-	EXPECT_NEAR(20.0 - 3.0 * std::sqrt(20.0), 6.58, 1e-2);
+	EXPECT_NEAR((12.0 - 6.588) / std::sqrt(6.588), 2.109, 1e-3);
+	EXPECT_NEAR((20.0 - 12.0) / std::sqrt(20.0), 1.789, 1e-3);
 	const ElevationGrid dense = lowTop(12);
 	ism.compute(dense, handDetection(kFloor), sensor, 5.0, st, &b);
-	EXPECT_GT(ism.evidence()[cellAt(dense, kSmearV)], 0.5f) << "12 > 6.58";
+	EXPECT_GT(ism.evidence()[cellAt(dense, kSmearV)], 0.5f) << "2.109 > 1.789: its own surface";
 	EXPECT_EQ(st.smeared, 0u);
 	const ElevationGrid sparse = lowTop(6);
 	ism.compute(sparse, handDetection(kFloor), sensor, 5.0, st, &b);
-	EXPECT_EQ(ism.evidence()[cellAt(sparse, kSmearV)], 0.5f) << "6 <= 6.58 and <= 14.29";
+	EXPECT_EQ(ism.evidence()[cellAt(sparse, kSmearV)], 0.5f) << "6 <= 14.29, and 0.229 < 3.130";
 	EXPECT_EQ(st.smeared, 1u);
 
 	// A camera whose 3 sigma stays under a cell (3 mm: 3 sigma + half a cell

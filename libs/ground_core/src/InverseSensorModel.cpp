@@ -321,16 +321,18 @@ bool InverseSensorModel::smeared(
 
 		// This cell's samples are that cell's if they are no more than its
 		// noise puts here (expected lambda, and noise_sigmas Poisson
-		// deviations above it) and clearly fewer than it holds (noise_sigmas
-		// deviations below): a low object's top spread over a few cells is
+		// deviations above it) and nearer that count than the one a surface
+		// of its own, as dense as that cell, would give (in Poisson
+		// deviations of each): a low object's top spread over a few cells is
 		// as dense in each, a wall's samples in front of it are not.
 		const double n = double(beyond), nw = double(wBeyond);
-		if (n > nw - k * std::sqrt(nw)) continue;
+		if (!(n < nw)) continue;
 		const double d = std::hypot(g.cx(qx) - x, g.cy(qy) - y);
 		if (stay < 0) stay = 2.0 * phi(0.5 * res / sigma2d) - 1.0;
 		const double moved = phi((d + 0.5 * res) / sigma2d) - phi((d - 0.5 * res) / sigma2d);
 		const double lambda = nw * moved / stay;
-		if (n <= lambda + k * std::sqrt(lambda)) return true;
+		if (!(lambda > 0) || n > lambda + k * std::sqrt(lambda)) continue;
+		if (std::abs(n - lambda) / std::sqrt(lambda) < (nw - n) / std::sqrt(nw)) return true;
 	}
 	return false;
 }

@@ -92,9 +92,11 @@ struct IsmParams
 	 * vertical share of that move, and explains its samples beyond the band:
 	 * they are no more than that cell's noise puts there (n_w * moved / stay,
 	 * plus noise_sigmas Poisson deviations; moved and stay from the normal
-	 * distribution of the move, cell centres d apart) and clearly fewer than
-	 * that cell holds (n_w - noise_sigmas sqrt(n_w)), so that a low object's
-	 * top spread over a few cells keeps them all. Only cells whose centres
+	 * distribution of the move, cell centres d apart) and nearer that count
+	 * than n_w, what a surface of its own as dense as that cell would give,
+	 * each in its Poisson deviations: |n - lambda| / sqrt(lambda) < (n_w -
+	 * n) / sqrt(n_w). A low object's top spread over a few cells, as dense in
+	 * each, keeps them all. Only cells whose centres
 	 * are at least a cell apart are compared: a camera whose reach stays
 	 * under half a cell changes nothing (3 sigma < 8.3 mm: the Kinect One
 	 * nearer than 5.7 m, the Femto nearer than 3.9 m). Off: every such cell
