@@ -318,7 +318,6 @@ bool InverseSensorModel::smeared(
 		// of the displacement.
 		if (drop ? w.z_min - rise > v.z_min : w.z_max + rise < v.z_max) continue;
 		const uint32_t wBeyond = m_tailCell[q] ? m_tailCount[q] : w.count;
-
 		// This cell's samples are that cell's if they are no more than its
 		// noise puts here (expected lambda, and noise_sigmas Poisson
 		// deviations above it) and nearer that count than the one a surface
@@ -337,8 +336,7 @@ bool InverseSensorModel::smeared(
 	return false;
 }
 
-void InverseSensorModel::countTailSamples(
-	const ElevationGrid& frame, const BinnedPoints& samples, const Eigen::Vector3d& sensor, IsmStats& stats)
+void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats)
 {
 	// One pass over the frame's samples: each candidate cell counts those
 	// below its low threshold or above its high one that the 3-sigma rule
@@ -576,7 +574,7 @@ void InverseSensorModel::compute(
 	// The tail count's list, sized with the samples' buffer on every frame (a
 	// later frame then allocates nothing, candidates or not).
 	if (samples && m_tailSamples.size() < samples->capacity()) m_tailSamples.resize(samples->capacity());
-	if (!m_tailCandidates.empty()) countTailSamples(frame, *samples, sensor, stats);
+	if (!m_tailCandidates.empty()) countTailSamples(frame, *samples, stats);
 	// range_smear: every class and count of the frame is known now. Judge
 	// all held cells first, then give evidence (no verdict reads another).
 	for (Held& h : m_held) h.smeared = smeared(frame, h.cell, h.beyond, h.drop, sensor);

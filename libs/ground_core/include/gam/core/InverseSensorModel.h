@@ -181,8 +181,8 @@ struct IsmParams
 		visit(
 			ParamInfo{
 				"range_smear", 0, 1,
-				"a floor cell with a few samples above it, within the range noise in front of a taller obstacle "
-				"along its ray, gives no evidence (the obstacle's samples)"},
+				"an obstacle (drop) cell whose samples beyond the band are what the range noise of a cell of the "
+				"same class behind (before) it along its ray moves there gives no evidence"},
 			p.range_smear);
 		visit(
 			ParamInfo{"traversable_step", 0, 1, "bumps and dips smaller than this are floor for the robot [m]"},
@@ -445,9 +445,10 @@ class InverseSensorModel
 	/** Counts each candidate cell's kept samples beyond its threshold, then
 	 * decides it: deep_sample_test (a floor cell becomes a drop), or an
 	 * obstacle / drop judged by its extreme sample (min_obstacle_points of
-	 * them beyond the band give evidence, drop_ray_min_points cast a ray). */
-	void countTailSamples(
-		const ElevationGrid& frame, const BinnedPoints& samples, const Eigen::Vector3d& sensor, IsmStats& stats);
+	 * them beyond the band give evidence, drop_ray_min_points cast a ray);
+	 * the cells that pass are held for range_smear when it applies. The
+	 * counts stay until clearTailCandidates(). */
+	void countTailSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats);
 	/** range_smear: whether the `beyond` samples above (below, `drop`) the
 	 * band of the obstacle (drop) cell `cell` can be those of a cell of the
 	 * same class farther along its ray (nearer, for a drop), within

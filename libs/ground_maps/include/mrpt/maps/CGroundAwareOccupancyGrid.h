@@ -244,7 +244,11 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	 * the cone's edge toward its nearer neighbour, and its rays end on the
 	 * chord from that point to the neighbour's echo at the shared edge (never
 	 * nearer than the echo; the arc where the chord meets the rays within
-	 * kMinIncidence of grazing: a jump, not a surface). */
+	 * kMinIncidence of grazing: a jump, not a surface). Where the beam's
+	 * surface (the line through its nearer neighbour's echo and its own, a
+	 * third echo within 3 sigma of the scan's range noise of it) passes
+	 * behind the farther neighbour's echo, a concave corner: the rays end on
+	 * that line, capped at that echo's range. */
 	static mrpt::obs::CObservation2DRangeScan upsampleSparseScan(
 		const mrpt::obs::CObservation2DRangeScan& in, int raysPerBeam, bool nearEdge = true);
 	/** See upsampleSparseScan: 10 deg. [rad] */
