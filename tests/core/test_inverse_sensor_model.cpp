@@ -8,6 +8,7 @@
 #include <random>
 #include <set>
 #include <stdexcept>
+#include <vector>
 
 #include "gam/core/InverseSensorModel.h"
 #include "gam/core/RrtGroundDetector.h"
@@ -311,6 +312,37 @@ TEST(IsmFormulas, BinomialTailAndNormalTail)
 	EXPECT_NEAR(ism::normalTail(3.0), 0.0013499, 1e-7);
 	EXPECT_NEAR(ism::normalTail(2.0), 0.0227501, 1e-7);
 	EXPECT_NEAR(ism::normalTail(0.0), 0.5, 1e-15);
+}
+
+TEST(IsmFormulas, KthSmallestIsTheValueASortPutsThere)
+{
+	// By hand: {0.5, 0.1, 0.4, 0.2, 0.3} sorted is {0.1, 0.2, 0.3, 0.4, 0.5}.
+	std::vector<float> five{0.5f, 0.1f, 0.4f, 0.2f, 0.3f};
+	EXPECT_EQ(ism::kthSmallest(five.data(), 5, 2), 0.3f);
+	// Long enough for the partition rounds (more than 16 values): random
+	// values, many equal ones (a pivot repeated), ascending, descending and all
+	// equal; every k against a sorted copy.
+	std::mt19937 rng(7);
+	std::uniform_real_distribution<float> u(0.f, 0.05f);
+	std::uniform_int_distribution<int> few(0, 3);
+	for (int kind = 0; kind < 5; kind++)
+		for (size_t n : {17u, 40u, 301u})
+		{
+			std::vector<float> v(n);
+			for (size_t i = 0; i < n; i++)
+				v[i] = kind == 0   ? u(rng)
+					   : kind == 1 ? 0.01f * float(few(rng))
+					   : kind == 2 ? float(i)
+					   : kind == 3 ? float(n - i)
+								   : 0.02f;
+			std::vector<float> sorted = v;
+			std::sort(sorted.begin(), sorted.end());
+			for (size_t k = 0; k < n; k++)
+			{
+				std::vector<float> w = v;
+				ASSERT_EQ(ism::kthSmallest(w.data(), n, k), sorted[k]) << "kind " << kind << " n " << n << " k " << k;
+			}
+		}
 }
 
 namespace

@@ -21,14 +21,30 @@ void GridGeometry::validate() const
 	if (!std::isfinite(x_min) || !std::isfinite(y_min)) throw std::invalid_argument("grid origin must be finite");
 }
 
-size_t samplesInMarkedCells(const BinnedPoints& pts, const uint8_t* marked, std::vector<uint32_t>& out)
+size_t samplesInMarkedCells(const BinnedPoints& pts, const uint8_t* marked, std::vector<uint32_t>& out, bool fewMarked)
 {
 	const size_t n = pts.size();
 	if (out.size() < pts.capacity()) out.resize(pts.capacity());
 	const uint32_t* cellOf = pts.cells().begin();
 	uint32_t* list = out.data();
 	size_t listed = 0;
-	for (size_t i = 0; i < n; i++)
+	// Where marked cells are few, a block of samples with none of them is
+	// skipped after one test.
+	constexpr size_t kBlock = 16;
+	size_t i = 0;
+	if (fewMarked)
+		for (; i + kBlock <= n; i += kBlock)
+		{
+			uint32_t any = 0;
+			for (size_t j = 0; j < kBlock; j++) any |= marked[cellOf[i + j]];
+			if (!any) continue;
+			for (size_t j = i; j < i + kBlock; j++)
+			{
+				list[listed] = uint32_t(j);  // kept only if the cell is marked
+				listed += marked[cellOf[j]] != 0;
+			}
+		}
+	for (; i < n; i++)
 	{
 		list[listed] = uint32_t(i);  // kept only if the cell is marked
 		listed += marked[cellOf[i]] != 0;

@@ -37,6 +37,41 @@ double binomialTail(uint32_t n, double p, uint32_t k)
 	}
 	return std::max(0.0, 1.0 - below);
 }
+float kthSmallest(float* v, size_t n, size_t k)
+{
+	size_t lo = 0, hi = n;  // v[k] lies in [lo, hi)
+	for (int round = 0; hi - lo > 16 && round < 64; round++)
+	{
+		// Median of three as the pivot: an element of the range.
+		const float a = v[lo], b = v[lo + (hi - lo) / 2], c = v[hi - 1];
+		const float pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));
+		// Branch-free Lomuto passes: [lo, less) < pivot, [less, upTo) == pivot.
+		size_t less = lo;
+		for (size_t i = lo; i < hi; i++)
+		{
+			const float x = v[i];
+			v[i] = v[less];
+			v[less] = x;
+			less += x < pivot;
+		}
+		size_t upTo = less;
+		for (size_t i = less; i < hi; i++)
+		{
+			const float x = v[i];
+			v[i] = v[upTo];
+			v[upTo] = x;
+			upTo += x <= pivot;
+		}
+		if (k < less)
+			hi = less;
+		else if (k < upTo)
+			return pivot;
+		else
+			lo = upTo;
+	}
+	std::nth_element(v + lo, v + k, v + hi);
+	return v[k];
+}
 }  // namespace ism
 
 namespace paper
@@ -134,14 +169,12 @@ void InverseSensorModel::measureFloorNoise(
 		float* v = m_noiseSorted.data() + begin;
 		if (m_params.measure_floor_noise)
 		{
-			std::nth_element(v, v + long(n / 2), v + n);
-			m_floorNoise[b] = v[n / 2];
+			m_floorNoise[b] = ism::kthSmallest(v, n, n / 2);
 		}
 		// The cells' means around the plane: 1.4826 x the median |distance| is
 		// their std for a normal spread (robust to the odd bump among them).
 		float* o = m_offsetSorted.data() + begin;
-		std::nth_element(o, o + long(n / 2), o + n);
-		m_floorOffset[b] = 1.4826f * o[n / 2];
+		m_floorOffset[b] = 1.4826f * ism::kthSmallest(o, n, n / 2);
 	}
 }
 
@@ -346,7 +379,7 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 	// Most samples lie in other cells (thresholds -inf / +inf): one byte per
 	// cell tells, where the two thresholds are 8 bytes, far apart.
 	for (const TailCandidate& d : m_tailCandidates) m_tailCell[d.cell] = 1;
-	const size_t listed = samplesInMarkedCells(samples, m_tailCell.data(), m_tailSamples);
+	const size_t listed = samplesInMarkedCells(samples, m_tailCell.data(), m_tailSamples, true);
 	for (size_t k = 0; k < listed; k++)
 	{
 		const uint32_t i = m_tailSamples[k];
@@ -594,6 +627,9 @@ void InverseSensorModel::compute(
 	// Pass 2: the ray to a below-ground voxel crossed the ground plane and went
 	// on below it; no floor stopped it in between. Mark those cells, unless
 	// this frame saw ground there (a direct observation beats the inference).
+	// (A ray has at most max_drop_ray_length / (res / 2) steps: sized once.)
+	const size_t maxSteps = size_t(std::ceil(m_params.max_drop_ray_length / (0.5 * res))) + 1;
+	if (m_rayCells.size() < maxSteps) m_rayCells.resize(maxSteps);
 	for (uint32_t idx : m_dropVoxels)
 	{
 		const ElevationCell& c = frame.cell(idx);
@@ -633,15 +669,24 @@ void InverseSensorModel::compute(
 		// March in cell units from the voxel back along the ray (no division per step).
 		const double vx = (x - g.x_min) / res, vy = (y - g.y_min) / res;
 		const double sx = lx / res, sy = ly / res;
-		int lastCell = -1;
+		// The cells of the steps first, in a loop without branches (it
+		// vectorizes; -1 outside the grid), then the evidence.
+		int32_t* __restrict cellAt = m_rayCells.data();
+		const double nxd = g.nx, nyd = g.ny;
+		const int32_t nx = g.nx;
 		for (int s = 1; s < steps; s++)
 		{
 			const double back = 1.0 - double(s) / steps;
 			const double fx = vx - sx * back, fy = vy - sy * back;
-			if (!(fx >= 0 && fy >= 0 && fx < g.nx && fy < g.ny)) continue;
-			const int qx = int(fx), qy = int(fy);
-			const int q = int(g.index(qx, qy));
-			if (q == lastCell || uint32_t(q) == idx) continue;
+			const bool in = (fx >= 0) & (fy >= 0) & (fx < nxd) & (fy < nyd);
+			const int32_t qx = int32_t(in ? fx : 0.0), qy = int32_t(in ? fy : 0.0);
+			cellAt[s] = in ? qy * nx + qx : -1;
+		}
+		int lastCell = -1;
+		for (int s = 1; s < steps; s++)
+		{
+			const int q = cellAt[s];
+			if (q < 0 || q == lastCell || uint32_t(q) == idx) continue;
 			lastCell = q;
 			const VoxelClass qc = m_class[size_t(q)];
 			if (qc == VoxelClass::Ground || qc == VoxelClass::Overhead) continue;

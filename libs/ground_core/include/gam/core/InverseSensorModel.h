@@ -239,6 +239,11 @@ double groundProbability(double d, const IsmParams& p);
 double binomialTail(uint32_t n, double p, uint32_t k);
 /** P(Z < -x) for a standard normal Z. */
 inline double normalTail(double x) { return 0.5 * std::erfc(x / std::sqrt(2.0)); }
+/** The k-th smallest of v[0..n) (0-based, k < n; v is reordered), the value
+ * std::nth_element puts at v[k]. A quickselect whose partition has no branch
+ * per element: introselect's comparisons mispredict about every other time on
+ * a bin's unordered noise values (measureFloorNoise). No NaN in v. */
+float kthSmallest(float* v, size_t n, size_t k);
 /** Combines two pieces of evidence for one cell within a frame: occupied
  * evidence wins (the largest one), otherwise the strongest free one. */
 inline float combine(float a, float b)
@@ -492,6 +497,7 @@ class InverseSensorModel
 	std::vector<VoxelClass> m_class;
 	std::vector<uint32_t> m_classCells;
 	std::vector<uint32_t> m_dropVoxels;
+	std::vector<int32_t> m_rayCells;  ///< pass 2: the cell of each step of one drop ray
 	// Cells decided by counting samples: per cell a low threshold height
 	// (samples below count; -inf elsewhere) or a high one (+inf elsewhere),
 	// the count, and p0 of the deep-sample test.
