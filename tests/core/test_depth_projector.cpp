@@ -875,3 +875,70 @@ TEST(DepthProjector, FlyingPixelFilterDropsExactlyTheFlyingPixels)
 	EXPECT_GT(flying, 20u) << "the outline's mixed pixels";
 	EXPECT_EQ(nKept, nAll - flying);
 }
+
+TEST(DepthProjector, FlyingPixelFilterAtTheImageEdgeIsTheSameTest)
+{
+	// Mixed pixels on the image's outermost rows and columns, where a pixel's
+	// lines run off the image (0 there, as for no return): the filter in
+	// project() drops exactly the pixels isFlyingPixel() flags, pixel by pixel
+	// (compared sample by sample, in pixel order), with and without AVX2.
+	Image img;
+	std::mt19937 rng(11);
+	std::uniform_real_distribution<double> u(0, 1);
+	std::normal_distribution<double> noise(0, 3);
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+		{
+			// A box face at 1.5 m covering the top-left corner (rows < 20,
+			// columns < 30) in front of a wall at 3 m; its outline and the
+			// image's border rows and columns mix the two at random.
+			const bool box = r < 20 && c < 30;
+			const bool edge = (box && (r == 19 || c == 29)) || r < 3 || c < 3 || r >= H - 3 || c >= W - 3;
+			double mm = box ? 1500 : 3000;
+			if (edge && u(rng) < 0.3) mm = 1500 + (0.15 + 0.7 * u(rng)) * 1500;
+			img.at(r, c) = uint16_t(std::lround(mm + noise(rng)));
+		}
+	// Dropouts next to the border (a pixel beside one can be flying
+	// against nothing).
+	for (int r : {1, H - 2}) img.at(r, 10) = 0;
+	for (int c : {1, W - 2}) img.at(24, c) = 0;
+	const ElevationGrid grid(makeGeometry(-5, -5, 0.05, 200, 200));
+	const RigidTransform T = pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+	ProjectionFilter keepAll, dropFlying;
+	keepAll.drop_flying_pixels = false;
+	keepAll.max_range = dropFlying.max_range = 10;
+	BinnedPoints all;
+	DepthProjector().project(img.view(), camera(), T, keepAll, grid, all);
+	ASSERT_EQ(all.size(), size_t(W * H - 4)) << "every pixel with a return is in range and on the grid";
+	std::vector<uint32_t> expectCell;
+	std::vector<float> expectZ;
+	size_t sample = 0, flyingAtBorder = 0;
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+		{
+			if (img.at(r, c) == 0) continue;
+			const bool flying = DepthProjector::isFlyingPixel(img.view(), r, c, 1, 50.0f);
+			if (flying && (r < 3 || c < 3 || r >= H - 3 || c >= W - 3)) flyingAtBorder++;
+			if (!flying)
+			{
+				expectCell.push_back(all.cells()[sample]);
+				expectZ.push_back(all.heights()[sample]);
+			}
+			sample++;
+		}
+	EXPECT_GT(flyingAtBorder, 10u) << "the test must flag pixels within 3 of the edge";
+	for (const bool avx2 : {true, false})
+	{
+		SCOPED_TRACE(avx2 ? "AVX2 (where the CPU has it)" : "baseline");
+		DepthProjector proj;
+		proj.setAllowAvx2(avx2);
+		BinnedPoints kept;
+		proj.project(img.view(), camera(), T, dropFlying, grid, kept);
+		ASSERT_EQ(kept.size(), expectCell.size());
+		for (size_t i = 0; i < kept.size(); i++)
+		{
+			ASSERT_EQ(kept.cells()[i], expectCell[i]) << "sample " << i;
+			ASSERT_EQ(kept.heights()[i], expectZ[i]) << "sample " << i;
+		}
+	}
+}

@@ -1,6 +1,7 @@
 #include "gam/core/ElevationGrid.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -219,44 +220,82 @@ size_t ElevationGrid::interpolateIdw(const IdwParams& p)
 	y1 = std::min(m_geom.ny - 1, y1 + r);
 
 	// Weights depend only on the offset: precompute them.
-	m_idwWeights.assign(size_t(2 * r + 1) * size_t(2 * r + 1), 0.f);
+	const int W = 2 * r + 1;
+	m_idwWeights.assign(size_t(W) * size_t(W), 0.f);
 	for (int dy = -r; dy <= r; dy++)
 		for (int dx = -r; dx <= r; dx++)
 			if (dx || dy)
-				m_idwWeights[size_t(dy + r) * size_t(2 * r + 1) + size_t(dx + r)] =
+				m_idwWeights[size_t(dy + r) * size_t(W) + size_t(dx + r)] =
 					1.0f / std::pow(std::sqrt(float(dx * dx + dy * dy)), p.power);
 
-	size_t filled = 0;
-	for (int cy = y0; cy <= y1; cy++)
-		for (int cx = x0; cx <= x1; cx++)
+	// The window's cells once, as two planes padded by r (0 outside the
+	// grid): seen (1 or 0) and the mean of the seen ones (0 elsewhere).
+	// Every neighbour then adds w * seen and w * mean, the empty ones an
+	// exact +0, in the order the cell-by-cell loop added the seen ones: the
+	// same sums, bit for bit, as vector loops along a row (that loop read
+	// each neighbour's cell and divided for its mean up to 8 times).
+	// (Sized for the whole grid at once: a later frame's larger window then
+	// allocates nothing.)
+	const int bw = x1 - x0 + 1, pw = bw + 2 * r, ph = (y1 - y0 + 1) + 2 * r;
+	const size_t whole = size_t(m_geom.nx + 2 * r) * size_t(m_geom.ny + 2 * r);
+	if (m_idwSeen.size() < whole)
+	{
+		m_idwSeen.resize(whole);
+		m_idwMean.resize(whole);
+	}
+	if (m_idwRow.size() < 3 * size_t(m_geom.nx)) m_idwRow.resize(3 * size_t(m_geom.nx));
+	for (int py = 0; py < ph; py++)
+	{
+		float* __restrict seen = m_idwSeen.data() + size_t(py) * size_t(pw);
+		float* __restrict mean = m_idwMean.data() + size_t(py) * size_t(pw);
+		std::fill(seen, seen + pw, 0.f);
+		std::fill(mean, mean + pw, 0.f);
+		const int yy = y0 - r + py;
+		if (yy < 0 || yy >= m_geom.ny) continue;
+		const int from = std::max(0, r - x0), to = std::min(pw, m_geom.nx - (x0 - r));
+		const ElevationCell* row = m_cells.data() + size_t(yy) * size_t(m_geom.nx);
+		for (int px = from; px < to; px++)
 		{
-			ElevationCell& c = m_cells[m_geom.index(cx, cy)];
-			if (c.count) continue;
-			float sw = 0, swz = 0;
-			int nb = 0;
-			for (int dy = -r; dy <= r; dy++)
+			const ElevationCell& o = row[x0 - r + px];
+			seen[px] = o.count ? 1.f : 0.f;
+			mean[px] = o.count ? o.mean() : 0.f;
+		}
+	}
+
+	size_t filled = 0;
+	float* __restrict sw = m_idwRow.data();
+	float* __restrict swz = sw + bw;
+	float* __restrict nb = swz + bw;
+	for (int cy = y0; cy <= y1; cy++)
+	{
+		std::fill(sw, sw + 3 * bw, 0.f);
+		const size_t centre = size_t(cy - y0 + r) * size_t(pw) + size_t(r);
+		for (int dy = -r; dy <= r; dy++)
+			for (int dx = -r; dx <= r; dx++)
 			{
-				const int yy = cy + dy;
-				if (yy < 0 || yy >= m_geom.ny) continue;
-				for (int dx = -r; dx <= r; dx++)
+				if (!dx && !dy) continue;  // the cell itself is empty
+				const float w = m_idwWeights[size_t(dy + r) * size_t(W) + size_t(dx + r)];
+				const ptrdiff_t off = ptrdiff_t(dy) * pw + dx;
+				const float* __restrict seen = m_idwSeen.data() + centre + off;
+				const float* __restrict mean = m_idwMean.data() + centre + off;
+				for (int k = 0; k < bw; k++)
 				{
-					const int xx = cx + dx;
-					if (xx < 0 || xx >= m_geom.nx) continue;
-					const ElevationCell& o = m_cells[m_geom.index(xx, yy)];
-					if (!o.count) continue;
-					const float w = m_idwWeights[size_t(dy + r) * size_t(2 * r + 1) + size_t(dx + r)];
-					sw += w;
-					swz += w * o.mean();
-					nb++;
+					sw[k] += w * seen[k];
+					swz[k] += w * mean[k];
+					nb[k] += seen[k];
 				}
 			}
-			if (nb >= p.min_neighbours && sw > 0)
+		const float* seenHere = m_idwSeen.data() + centre;
+		const float minNb = float(p.min_neighbours);
+		for (int k = 0; k < bw; k++)
+			if (seenHere[k] == 0.f && nb[k] >= minNb && sw[k] > 0)
 			{
-				c.z_idw = swz / sw;
-				m_idwTouched.push_back(uint32_t(m_geom.index(cx, cy)));
+				const size_t i = m_geom.index(x0 + k, cy);
+				m_cells[i].z_idw = swz[k] / sw[k];
+				m_idwTouched.push_back(uint32_t(i));
 				filled++;
 			}
-		}
+	}
 	return filled;
 }
 

@@ -168,6 +168,7 @@ class DepthProjector
 	std::vector<int32_t> m_flyCols;
 	std::vector<float> m_flyLines;
 	std::vector<uint8_t> m_flyAlong, m_flyAgainstNothing;
+	std::vector<uint16_t> m_flyZeros;  // a row of 0 (beyond the image's edge)
 	bool m_allowAvx2 = true;
 };
 

@@ -295,6 +295,8 @@ class ElevationGrid
 	std::vector<uint8_t> m_flagged;          // 1: the cell's samples are re-accumulated within mean +- limit
 	std::vector<uint32_t> m_flaggedSamples;  // pass 2: the samples of flagged cells
 	std::vector<float> m_idwWeights;
+	std::vector<float> m_idwSeen, m_idwMean;  // interpolateIdw's padded window
+	std::vector<float> m_idwRow;              // its sums along a row
 	std::vector<uint32_t> m_idwNeighbours;
 };
 
