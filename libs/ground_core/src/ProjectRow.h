@@ -216,6 +216,11 @@ inline size_t compactRow(
 // it in depth (|2 p1 - p2 - x| <= h, both of its pixels with a return), when
 // x jumps by more than t to neither neighbour (then it is between none) or
 // when a neighbour has no return and the other is not nearer by more than t.
+// Not quite "cannot": a side that continues x also clears x where x is the
+// second pixel of a pair (p1, x) that the full rule flags, p1 being flying
+// itself (5-13 pixels a frame on simulated Kinect One and Femto frames; test
+// FirstPassKeepsThePairedPixelThatOneSideContinues). What project() drops
+// is this pass, then the full rule on its candidates.
 // All in 16-bit arithmetic (16 pixels per AVX2 instruction): |e| <= h is
 // tested as (e + h) mod 2^16 <= 2 h, which can wrongly clear a pixel only
 // when |2 p1 - p2 - x| >= 2^16 - h, i.e. for depths over 2^15 units (33 m
