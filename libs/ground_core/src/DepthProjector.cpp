@@ -122,38 +122,48 @@ inline bool supportedAlong(const float* v, float tol)
 	return (v[2] > 0 && std::abs(v[2] - v[3]) <= tol) || (v[4] > 0 && std::abs(v[4] - v[3]) <= tol);
 }
 
-// Both lines through pixel (r, c), neighbours `step` apart.
-bool flyingAt(const RangeImageView& img, int r, int c, int step, float tol)
+// Both lines through pixel (r, c), neighbours `step` apart: h along its row,
+// w along its column (offsets -3 ... +3, the pixel at [3]), 0 beyond the
+// image's edge.
+inline void linesAt(const RangeImageView& img, int r, int c, int step, float* h, float* w)
 {
-	float h[7], w[7];
 	const int reach = 3 * step;
 	if (r >= reach && c >= reach && r + reach < img.rows && c + reach < img.cols)
 	{
 		const uint16_t* p = img.data + size_t(r) * img.stride + size_t(c);
-		if (p[0] == 0) return false;
 		const ptrdiff_t down = ptrdiff_t(img.stride) * step;
 		for (int o = -3; o <= 3; o++)
 		{
 			h[o + 3] = float(p[o * step]);
 			w[o + 3] = float(p[o * down]);
 		}
+		return;
 	}
-	else
+	auto v = [&](int rr, int cc) -> float {
+		return (rr < 0 || cc < 0 || rr >= img.rows || cc >= img.cols) ? 0.f : float(img.at(rr, cc));
+	};
+	for (int o = -3; o <= 3; o++)
 	{
-		auto v = [&](int rr, int cc) -> float {
-			return (rr < 0 || cc < 0 || rr >= img.rows || cc >= img.cols) ? 0.f : float(img.at(rr, cc));
-		};
-		if (!(v(r, c) > 0)) return false;
-		for (int o = -3; o <= 3; o++)
-		{
-			h[o + 3] = v(r, c + o * step);
-			w[o + 3] = v(r + o * step, c);
-		}
+		h[o + 3] = v(r, c + o * step);
+		w[o + 3] = v(r + o * step, c);
 	}
-	// Neither test can hold without a spread along one of the lines (most
-	// pixels have none).
+}
+
+// Neither flying test can hold without a spread along one of the lines
+// (most pixels have none).
+inline bool spreadOnEitherLine(const float* h, const float* w, float tol)
+{
 	const float wholeTol = std::floor(tol);
-	if (!spreadAlong(h, wholeTol) && !spreadAlong(w, wholeTol)) return false;
+	return spreadAlong(h, wholeTol) || spreadAlong(w, wholeTol);
+}
+
+// Both lines through pixel (r, c), neighbours `step` apart.
+bool flyingAt(const RangeImageView& img, int r, int c, int step, float tol)
+{
+	if (img.at(r, c) == 0) return false;
+	float h[7], w[7];
+	linesAt(img, r, c, step, h, w);
+	if (!spreadOnEitherLine(h, w, tol)) return false;
 	if (flyingAlong(h, tol) || flyingAlong(w, tol)) return true;
 	if (!againstNothingAlong(h, tol) && !againstNothingAlong(w, tol)) return false;
 	// Against no return, a pixel must also stand alone: no neighbour of the
@@ -196,14 +206,8 @@ __attribute__((noinline)) bool gatherLinesAtEdge(
 	const RangeImageView& img, int r, int c, float tol, float* line, size_t stride)
 {
 	float h[7], w[7];
-	for (int o = -3; o <= 3; o++)
-	{
-		const int cc = c + o, rr = r + o;
-		h[o + 3] = cc >= 0 && cc < img.cols ? float(img.at(r, cc)) : 0.f;
-		w[o + 3] = rr >= 0 && rr < img.rows ? float(img.at(rr, c)) : 0.f;
-	}
-	const float wholeTol = std::floor(tol);
-	if (!(h[3] > 0) || (!spreadAlong(h, wholeTol) && !spreadAlong(w, wholeTol))) return false;
+	linesAt(img, r, c, 1, h, w);
+	if (!(h[3] > 0) || !spreadOnEitherLine(h, w, tol)) return false;
 	for (int o = 0; o < 7; o++)
 	{
 		line[size_t(o) * stride] = h[o];
