@@ -1347,6 +1347,136 @@ TEST(InverseSensorModel, AWallsSamplesPushedTowardTheCameraGiveNoObstacleInFront
 	EXPECT_EQ(st.smeared, 0u);
 }
 
+TEST(InverseSensorModel, AWallJustBeyondTheRangeLimitGivesNoObstacleInFrontOfIt)
+{
+	// A wall just beyond the camera's range limit returns only the samples
+	// its range noise brings nearer. V (x = 4.025, seen from (0, 0, 0.5)) holds
+	// 20 floor samples and 30 from 0.1 to 0.5 m; nothing was seen beyond it.
+	// V's top sample is level with the sensor: rho = r = hypot(4.025, 0.025)
+	// = 4.025078, sigma = 0.03 m all horizontal, the walk reaches 3 sigma +
+	// half a cell = 0.115 m in half cells: t = 0.05 (x = 4.075, the cell
+	// [4.05, 4.10)), 0.075 (the same cell, not looked at again), 0.1 (the
+	// cell [4.10, 4.15)). Along V's ray the depth (the camera level: along
+	// x) grows by 4.025 / 4.025078 = 0.9999807 per metre from V's 4.025: a
+	// limit of 4.10 lies 0.075 / 0.9999807 = 0.0750014 m beyond V's centre.
+	const double rho = std::hypot(4.025, 0.025);
+	EXPECT_NEAR(rho, 4.025078, 1e-6);
+	EXPECT_NEAR(4.025 / rho, 0.9999807, 1e-7);
+	EXPECT_NEAR(0.075 / (4.025 / rho), 0.0750014, 1e-7);
+	IsmParams p;
+	ASSERT_TRUE(p.range_smear);
+	ASSERT_EQ(p.noise_sigmas, 3.0);
+	IsmStats st;
+	BinnedPoints b;
+	const Eigen::Vector3d sensor{0, 0, 0.5};
+	const auto frame = [&](bool floorBeyond) {
+		ElevationGrid grid;
+		b.clear();
+		for (int i = 0; i < 20; i++) grid.binPoint(kSmearV, kSmearY, 0.f, b);
+		for (int i = 0; i < 30; i++) grid.binPoint(kSmearV, kSmearY, float(0.1 + 0.4 * i / 29.0), b);
+		if (floorBeyond)
+			for (int i = 0; i < 20; i++) grid.binPoint(4.075, kSmearY, 0.f, b);
+		grid.insert(b, OutlierFilterParams{});
+		return grid;
+	};
+	const ElevationGrid f = frame(false);
+	const uint32_t v = uint32_t(f.geometry().index(f.geometry().ix(kSmearV), f.geometry().iy(kSmearY)));
+	const auto evidenceWith = [&](const ElevationGrid& fr, const Eigen::Vector3d& forward, double limit) {
+		InverseSensorModel ism(p);
+		ism.setCameraNoise(flatNoise(0.03), 500);
+		ism.setCameraRangeLimit(forward, limit);
+		ism.compute(fr, handDetection(kFloor), sensor, 5.0, st, &b);
+		EXPECT_EQ(ism.classes()[v], VoxelClass::Obstacle);
+		return ism.evidence()[v];
+	};
+	const Eigen::Vector3d level(1, 0, 0);
+	// t = 0.1 > 0.0750014, with only unseen cells on the way.
+	EXPECT_EQ(evidenceWith(f, level, 4.10), 0.5f) << "the samples of a surface beyond the limit";
+	EXPECT_EQ(st.smeared, 1u);
+	// A limit at 4.20 (0.175 m on) is out of the walk's reach, and there is
+	// none by default: they count.
+	EXPECT_GT(evidenceWith(f, level, 4.20), 0.5f);
+	EXPECT_EQ(st.smeared, 0u);
+	{
+		InverseSensorModel ism(p);
+		ism.setCameraNoise(flatNoise(0.03), 500);
+		ism.compute(f, handDetection(kFloor), sensor, 5.0, st, &b);
+		EXPECT_GT(ism.evidence()[v], 0.5f) << "default: no limit";
+	}
+	// The limit is on the depth along the camera's axis: pitched 30 deg down,
+	// V's depth is 4.025 cos 30 deg = 3.4857 and grows by 0.9999807 cos 30
+	// deg = 0.86601 per metre of its ray: 4.10 lies 0.7093 m on, out of
+	// reach. Measured as the range (a zero axis), 4.10 lies 4.10 - 4.025078
+	// = 0.0749 m on, as for the level camera.
+	EXPECT_NEAR(4.025 * std::cos(M_PI / 6), 3.4857, 1e-4);
+	EXPECT_NEAR((4.10 - 4.025 * std::cos(M_PI / 6)) / (4.025 / rho * std::cos(M_PI / 6)), 0.7093, 1e-4);
+	EXPECT_GT(evidenceWith(f, Eigen::Vector3d(std::cos(M_PI / 6), 0, -std::sin(M_PI / 6)), 4.10), 0.5f);
+	EXPECT_EQ(evidenceWith(f, Eigen::Vector3d::Zero(), 4.10), 0.5f);
+	// Floor seen beyond V (x = 4.075): the samples end on the floor, not at
+	// the limit; V is an object of its own.
+	const ElevationGrid seen = frame(true);
+	EXPECT_GT(evidenceWith(seen, level, 4.10), 0.5f);
+	EXPECT_EQ(st.smeared, 0u);
+}
+
+TEST(InverseSensorModel, AWallAtTheRangeLimitKeepsOnlyHalfItsSamples)
+{
+	// The wall W of AWallsSamplesPushedTowardTheCamera... (300 samples at x =
+	// 4.075, sensor (0, 0, 0.5)), seen by a camera of sigma 2 cm, with 90
+	// samples in front of it in V (4.025). The walk from V reaches 3 sigma +
+	// half a cell = 0.085 m: W's cell only (t = 0.05, 0.075). W keeps 2
+	// Phi(0.025 / 0.02) - 1 = 0.788700 of its surface's samples and moves
+	// Phi(0.075 / 0.02) - Phi(0.025 / 0.02) = 0.105561 into V: lambda = 300 x
+	// 0.105561 / 0.788700 = 40.153, bound 40.153 + 3 sqrt(40.153) = 59.16 <
+	// 90: they count. With the limit at W's centre (4.075 along the level
+	// axis: 0.05 / 0.9999807 = 0.05000096 m beyond V's centre, 0.00000096 m
+	// beyond W's) the samples its noise moves past its centre are cut: it
+	// keeps Phi(0.00000096 / 0.02) - Phi(-0.025 / 0.02) = 0.394369, lambda =
+	// 300 x 0.105561 / 0.394369 = 80.301, bound 80.301 + 3 sqrt(80.301) =
+	// 107.18 >= 90, and |90 - 80.301| / sqrt(80.301) = 1.082 < (300 - 90) /
+	// sqrt(300) = 12.124: W's samples.
+	const double stay = 1.0 - 2.0 * ism::normalTail(0.025 / 0.02);
+	const double moved = ism::normalTail(-0.075 / 0.02) - ism::normalTail(-0.025 / 0.02);
+	const double room = 0.05 / (4.025 / std::hypot(4.025, 0.025)) - 0.05;  // W's centre to the limit
+	EXPECT_NEAR(room, 0.00000096, 1e-8);
+	const double kept = ism::normalTail(-room / 0.02) - ism::normalTail(0.025 / 0.02);
+	EXPECT_NEAR(stay, 0.788700, 1e-6);
+	EXPECT_NEAR(moved, 0.105561, 1e-6);
+	EXPECT_NEAR(kept, 0.394369, 1e-6);
+	EXPECT_NEAR(300.0 * moved / stay, 40.153, 1e-3);
+	EXPECT_NEAR(40.153 + 3.0 * std::sqrt(40.153), 59.16, 1e-2);
+	const double lambda = 300.0 * moved / kept;
+	EXPECT_NEAR(lambda, 80.301, 1e-3);
+	EXPECT_NEAR(lambda + 3.0 * std::sqrt(lambda), 107.18, 1e-2);
+	EXPECT_NEAR((90.0 - lambda) / std::sqrt(lambda), 1.082, 1e-3);
+	EXPECT_NEAR(210.0 / std::sqrt(300.0), 12.124, 1e-3);
+	IsmParams p;
+	IsmStats st;
+	BinnedPoints b;
+	const Eigen::Vector3d sensor{0, 0, 0.5};
+	const auto evidenceOfV = [&](const ElevationGrid& f, double sigma, double limit) {
+		InverseSensorModel ism(p);
+		ism.setCameraNoise(flatNoise(sigma), 500);
+		if (std::isfinite(limit)) ism.setCameraRangeLimit(Eigen::Vector3d(1, 0, 0), limit);
+		ism.compute(f, handDetection(kFloor), sensor, 5.0, st, &b);
+		return ism.evidence()[f.geometry().index(f.geometry().ix(kSmearV), f.geometry().iy(kSmearY))];
+	};
+	const double none = std::numeric_limits<double>::infinity();
+	const ElevationGrid f90 = smearFrame(90, b);
+	EXPECT_GT(evidenceOfV(f90, 0.02, none), 0.5f) << "90 > 59.16";
+	EXPECT_EQ(evidenceOfV(f90, 0.02, 4.075), 0.5f) << "90 <= 107.18: the samples of a wall cut by the limit";
+	// Sigma 3 cm (the walk reaches 0.115 m) and 200 samples in V, more than
+	// W's noise puts there (bound 128.65, see above). The limit at 4.12 lies
+	// 0.0950018 m beyond V's centre and 0.0450018 m beyond W's, more than
+	// half a cell: W is a surface seen inside the limit, as high as V, that
+	// stands between them. The walk's t = 0.1 > 0.0950018, an unseen cell
+	// past the limit, but V's samples are not a surface's beyond it. (W
+	// itself, its walk past the limit at its first step, is taken for one.)
+	const ElevationGrid f200 = smearFrame(200, b);
+	EXPECT_GT(evidenceOfV(f200, 0.03, 4.12), 0.5f) << "a surface seen between V and the limit";
+	EXPECT_EQ(st.smeared, 1u);
+}
+
 TEST(InverseSensorModel, AStepDownsSamplesPushedAwayGiveNoDropBeyondItsEdge)
 {
 	// The mirror case: the face of a step down (a drop cell W at x = 4.025,

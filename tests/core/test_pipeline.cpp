@@ -199,3 +199,63 @@ TEST(Pipeline, CropsAtRobotHeightInTheRobotFrame)
 	EXPECT_FLOAT_EQ(f.z_max, 0.5f + 1.2f);               // min(z_max 2.5, robot_height 1.2)
 	EXPECT_FLOAT_EQ(f.max_range, 5.0f);
 }
+
+TEST(Pipeline, AWallJustOutOfTheCamerasRangeLeavesNoObstacleInFrontOfIt)
+{
+	// A level camera 1 m up whose depth stops at 4.0 m (the frame's
+	// max_range, as CObservation3DRangeScan::maxRange gives it), facing a
+	// wall at x = 4.05: only the wall samples that the range noise brought
+	// 9 cm nearer come back (depth 3.96, heights 0.05-0.95 m), all in the
+	// cells [3.95, 4.00). With a level camera a pixel's depth is its x. The
+	// camera's range sigma is 3 cm (camera_model = custom), so the walk from
+	// those cells reaches 3 sigma + half a cell = 0.115 m on: its first step,
+	// x = 4.025 (depth 4.025 > 4.0), is past the limit with nothing seen.
+	PinholeIntrinsics K;
+	K.width = 160;
+	K.height = 120;
+	K.fx = K.fy = 120;
+	K.cx = 79.5;
+	K.cy = 59.5;
+	const Eigen::Vector3d camPos(0, 0, 1.0);
+	const Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+	const double wallX = 4.05, limit = 4.0, pulledTo = 3.96;
+	const std::vector<uint16_t> depth = gamtest::renderDepth(K, R, [&](const Eigen::Vector3d& w) {
+		const double floorT = w.z() < 0 ? -camPos.z() / w.z() : std::numeric_limits<double>::infinity();
+		if (floorT <= limit) return floorT;
+		const double zAtWall = camPos.z() + wallX * w.z();
+		return wallX < floorT && zAtWall >= 0.05 && zAtWall <= 0.95 ? pulledTo : -1.0;
+	});
+	PipelineParams params;
+	params.m_x = params.m_y = 240;
+	params.projection.drop_flying_pixels = false;  // not what this is about
+	params.camera.model = CameraModel::Custom;
+	params.camera.custom.tof_c0 = 0.03;
+	params.camera.range_of_trust = false;  // 3 cm at 4 m: no trust there, and so no evidence at all
+	const auto wallRow = [&](double maxRange, size_t& cells, size_t& occupied) {
+		SensorFrame frame = gamtest::depthFrame(depth, K, R, camPos);
+		frame.max_range = float(maxRange);
+		GroundAwarePipeline pipeline(params);
+		const FrameResult& res = pipeline.process(frame, Eigen::Vector3d(0, 0, 0), GridLattice{0, 0, 0.05});
+		EXPECT_EQ(res.detection.status, GroundDetection::Status::Ok) << res.detection.describe();
+		const GridGeometry& g = pipeline.frameGrid().geometry();
+		cells = occupied = 0;
+		for (double y = -0.975; y < 1.0; y += 0.05)
+		{
+			const size_t idx = g.index(g.ix(3.975), g.iy(y));
+			if (pipeline.frameGrid().cell(idx).count == 0) continue;
+			cells++;
+			occupied += pipeline.ism().evidence()[idx] > 0.5f;
+		}
+		return res.ism.smeared;
+	};
+	size_t cells = 0, occupied = 0;
+	// The camera's limit, declared: those samples are the wall's beyond it.
+	EXPECT_GE(wallRow(limit, cells, occupied), 30u);
+	EXPECT_GE(cells, 35u);
+	EXPECT_EQ(occupied, 0u);
+	// Not declared (the projection's 5 m): the same samples are an object of
+	// their own, a row of obstacles 5 cm in front of the wall.
+	EXPECT_EQ(wallRow(std::numeric_limits<float>::infinity(), cells, occupied), 0u);
+	EXPECT_GE(cells, 35u);
+	EXPECT_EQ(occupied, cells);
+}

@@ -180,6 +180,12 @@ const FrameResult& GroundAwarePipeline::process(
 	// 3. Evidence, within the range of trust of the camera.
 	m_result.sensor = frame.sensor_position;
 	m_ism.setCameraNoise(noise, frame.intrinsics.fx);
+	// The samples end where binSensorFrame cut them: a depth image on its
+	// depth (the camera's x axis), a range image or a point cloud on the range.
+	m_ism.setCameraRangeLimit(
+		frame.has_image && frame.image.is_depth ? Eigen::Vector3d(frame.sensor_to_map.R.cast<double>().col(0))
+												: Eigen::Vector3d::Zero(),
+		std::min<double>(m_params.projection.max_range, frame.max_range));
 	m_ism.compute(m_grid, m_result.detection, m_result.sensor, evidenceRange, m_result.ism, &m_bins);
 	const auto t4 = clk::now();
 

@@ -335,7 +335,23 @@ bool InverseSensorModel::smeared(
 	const double sign = drop ? -1.0 : 1.0;
 	const double ux = sign * dx / rho, uy = sign * dy / rho;
 	const VoxelClass same = drop ? VoxelClass::Drop : VoxelClass::Obstacle;
+	// Where the frame's samples end (setCameraRangeLimit): `limit` beyond
+	// this cell's centre, horizontally, along the ray through its extreme
+	// sample (a sample's error moves it along its ray). An obstacle's walk
+	// goes away from the sensor, toward the limit; a surface beyond it returns
+	// only the samples its noise brings nearer, and of a cell near it the
+	// limit cuts the samples its noise moves past it.
+	double limit = std::numeric_limits<double>::infinity();
+	if (!drop && std::isfinite(m_rangeLimit))
+	{
+		const Eigen::Vector3d ray(dx, dy, dz);
+		const bool onRange = m_rangeAxis.isZero();
+		const double along = onRange ? r : ray.dot(m_rangeAxis);  // this sample's depth (range)
+		const double perMetre = onRange ? 1.0 : ray.dot(m_rangeAxis) / r;
+		if (perMetre > 0) limit = (m_rangeLimit - along) / perMetre * rho / r;
+	}
 	uint32_t last = cell;
+	bool seenBefore = false;  // a surface as high seen inside the limit, on the way to it
 	for (double t = res; t <= reach2d + step + 1e-9; t += step)
 	{
 		const int qx = g.ix(x + t * ux), qy = g.iy(y + t * uy);
@@ -344,12 +360,28 @@ bool InverseSensorModel::smeared(
 		if (q == last) continue;
 		last = q;
 		const VoxelClass qc = m_class[q];
-		if (qc == VoxelClass::None) continue;  // not seen in this frame: look on
-		if (qc != same) return false;          // anything else between them: a separate object
+		if (qc == VoxelClass::None)
+		{
+			// Not seen in this frame: look on. Past the limit with nothing seen
+			// on the way: these samples may all be those a surface beyond the
+			// limit returned (a wall just out of range).
+			if (t > limit && !seenBefore) return true;
+			continue;
+		}
+		if (qc != same) return false;  // anything else between them: a separate object
 		const ElevationCell& w = frame.cell(q);
 		// As high (deep) as this cell's extreme sample, less the vertical share
 		// of the displacement.
 		if (drop ? w.z_min - rise > v.z_min : w.z_max + rise < v.z_max) continue;
+		const double d = std::hypot(g.cx(qx) - x, g.cy(qy) - y);
+		// The share of that cell's samples its noise leaves there, less those
+		// it moves past the limit; a cell wholly inside it is a surface seen
+		// in its own right between this one and the limit.
+		if (stay < 0) stay = 2.0 * phi(0.5 * res / sigma2d) - 1.0;
+		const double room = limit - d;
+		const double stayHere = room >= 0.5 * res ? stay : phi(room / sigma2d) - phi(-0.5 * res / sigma2d);
+		seenBefore |= room >= 0.5 * res;
+		if (!(stayHere > 0)) continue;
 		const uint32_t wBeyond = m_tailCell[q] ? m_tailCount[q] : w.count;
 		// This cell's samples are that cell's if they are no more than its
 		// noise puts here (expected lambda, and noise_sigmas Poisson
@@ -359,10 +391,8 @@ bool InverseSensorModel::smeared(
 		// as dense in each, a wall's samples in front of it are not.
 		const double n = double(beyond), nw = double(wBeyond);
 		if (!(n < nw)) continue;
-		const double d = std::hypot(g.cx(qx) - x, g.cy(qy) - y);
-		if (stay < 0) stay = 2.0 * phi(0.5 * res / sigma2d) - 1.0;
 		const double moved = phi((d + 0.5 * res) / sigma2d) - phi((d - 0.5 * res) / sigma2d);
-		const double lambda = nw * moved / stay;
+		const double lambda = nw * moved / stayHere;
 		if (!(lambda > 0) || n > lambda + k * std::sqrt(lambda)) continue;
 		if (std::abs(n - lambda) / std::sqrt(lambda) < (nw - n) / std::sqrt(nw)) return true;
 	}

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "gam/core/CameraNoise.h"
@@ -361,6 +362,18 @@ class InverseSensorModel
 		m_camera = noise;
 		m_fx = fx;
 	}
+	/** Where the frame's samples end: beyond `limit` [m] the camera (or the
+	 * projection's max_range) returned nothing. Measured along `forward`,
+	 * the camera's optical axis in the map frame (a depth image, cut on its
+	 * depth), or as the range from the sensor when `forward` is zero (a
+	 * range image or a point cloud). A surface just beyond the limit still
+	 * returns the samples its range noise brings nearer, and only those:
+	 * range_smear takes them for that surface's. Default: no limit. */
+	void setCameraRangeLimit(const Eigen::Vector3d& forward, double limit)
+	{
+		m_rangeAxis = forward;
+		m_rangeLimit = limit;
+	}
 	/** Validates (throws std::invalid_argument), then keeps `p`: compute()
 	 * runs with parameters checked once, not on every frame. */
 	void setParams(const IsmParams& p)
@@ -433,6 +446,8 @@ class InverseSensorModel
 	float obstacleEvidence(const ElevationCell& c, double resolution) const;
 	CameraNoise m_camera;  ///< of the frame (setCameraNoise)
 	double m_fx = 0;
+	Eigen::Vector3d m_rangeAxis = Eigen::Vector3d::Zero();          ///< setCameraRangeLimit
+	double m_rangeLimit = std::numeric_limits<double>::infinity();  ///< setCameraRangeLimit [m]
 	/** Samples an obstacle (min_obstacle_points) or a drop (min_drop_points) needs. */
 	uint32_t minPoints(VoxelClass c, bool onPatch) const
 	{
@@ -458,8 +473,10 @@ class InverseSensorModel
 	/** range_smear: whether the `beyond` samples above (below, `drop`) the
 	 * band of the obstacle (drop) cell `cell` can be those of a cell of the
 	 * same class farther along its ray (nearer, for a drop), within
-	 * noise_sigmas of the camera's range noise. Reads the frame's classes and
-	 * the tail candidates' counts, so it runs after countTailSamples. */
+	 * noise_sigmas of the camera's range noise, or (an obstacle) those of a
+	 * surface beyond the frame's range limit (setCameraRangeLimit). Reads the
+	 * frame's classes and the tail candidates' counts, so it runs after
+	 * countTailSamples. */
 	bool smeared(
 		const ElevationGrid& frame, uint32_t cell, uint32_t beyond, bool drop, const Eigen::Vector3d& sensor) const;
 	/** An obstacle or drop cell about to give evidence: its samples beyond
