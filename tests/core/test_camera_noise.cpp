@@ -148,12 +148,7 @@ TEST(GroundOffset, AStageTheTreeGrewOnIsNoFloor)
 	// robot, more than max_ground_offset 0.10: the frame is judged against the robot's
 	// floor (z = 0), and the stage top, 0.20 m above it, is an obstacle. With the rule
 	// off the stage is ground: free.
-	PinholeIntrinsics K;
-	K.width = 160;
-	K.height = 120;
-	K.fx = K.fy = 120;
-	K.cx = 79.5;
-	K.cy = 59.5;
+	const PinholeIntrinsics K = gamtest::smallCamera();
 	const Eigen::Vector3d camPos(0, 0, 1.0);
 	const Eigen::Matrix3d R = Eigen::AngleAxisd(deg2rad(25), Eigen::Vector3d::UnitY()).toRotationMatrix();
 	const std::vector<uint16_t> depth = gamtest::renderDepth(K, R, [&](const Eigen::Vector3d& w) {

@@ -37,6 +37,19 @@ inline std::vector<uint16_t> renderDepth(
 	return depth;
 }
 
+/** The small camera of the pipeline tests: 160 x 120 pixels, fx = fy = 120
+ * (67 x 53 deg), principal point at the image centre. */
+inline gam::PinholeIntrinsics smallCamera()
+{
+	gam::PinholeIntrinsics K;
+	K.width = 160;
+	K.height = 120;
+	K.fx = K.fy = 120;
+	K.cx = 79.5;
+	K.cy = 59.5;
+	return K;
+}
+
 /** The SensorFrame of such an image (it must outlive the frame). */
 inline gam::SensorFrame depthFrame(
 	const std::vector<uint16_t>& depth, const gam::PinholeIntrinsics& K, const Eigen::Matrix3d& R,

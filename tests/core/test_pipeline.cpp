@@ -59,12 +59,7 @@ double castRay(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double floorZ
 
 TEST(Pipeline, DepthImageOfFloorAndBoxToEvidence)
 {
-	PinholeIntrinsics K;
-	K.width = 160;
-	K.height = 120;
-	K.fx = K.fy = 120;
-	K.cx = 79.5;
-	K.cy = 59.5;
+	const PinholeIntrinsics K = gamtest::smallCamera();
 	const Eigen::Vector3d camPos(0, 0, 1.0);
 	const Eigen::Matrix3d R = Eigen::AngleAxisd(deg2rad(25), Eigen::Vector3d::UnitY()).toRotationMatrix();
 	const Box box{{1.5, -0.2, 0.0}, {1.9, 0.2, 0.3}};
@@ -210,12 +205,7 @@ TEST(Pipeline, AWallJustOutOfTheCamerasRangeLeavesNoObstacleInFrontOfIt)
 	// camera's range sigma is 3 cm (camera_model = custom), so the walk from
 	// those cells reaches 3 sigma + half a cell = 0.115 m on: its first step,
 	// x = 4.025 (depth 4.025 > 4.0), is past the limit with nothing seen.
-	PinholeIntrinsics K;
-	K.width = 160;
-	K.height = 120;
-	K.fx = K.fy = 120;
-	K.cx = 79.5;
-	K.cy = 59.5;
+	const PinholeIntrinsics K = gamtest::smallCamera();
 	const Eigen::Vector3d camPos(0, 0, 1.0);
 	const Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
 	const double wallX = 4.05, limit = 4.0, pulledTo = 3.96;
