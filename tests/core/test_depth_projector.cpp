@@ -778,21 +778,36 @@ TEST(DepthProjector, FlyingPixelsAreTheMixedPixelsOfAnEdge)
 		for (int r = 0; r < 5; r++) img.at(r, 5) = uint16_t(column[r]);
 		EXPECT_TRUE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
 		EXPECT_FALSE(DepthProjector::isFlyingPixel(img.view(), 2, 4, 1, tol)) << "the jamb itself";
+		// Two mixed pixels that happen to lie within 50 mm of each other: 3230
+		// diagonally up and right of 3200, and nothing (0) two pixels off on
+		// that diagonal. A pair at random depths, not a surface that goes on:
+		// flying.
+		img.at(1, 6) = 3230;
+		EXPECT_TRUE(DepthProjector::isFlyingPixel(img.view(), 2, 5, 1, tol));
+		img.at(1, 6) = 0;
 		// The floor just past a step's edge looks the same along its column
 		// (here the row): 4000 on the upper floor, then 4270 (a 5 cm step seen
 		// from 0.8 m: 5/80 = 6.25 % farther, more than 5 % of 4270 = 213.5 mm),
-		// then a dropout. But the lower floor goes on across the image: its
-		// neighbours in the other line, 4265 and 4280, are within 50 mm. Kept.
+		// then a dropout. But the lower floor goes on across the image: in the
+		// other line 4265 is within 50 mm of it and 4255 within 50 mm of 4265
+		// (and 4280, 4290 below). Kept.
 		Image step = rowImage({4000, 4000, 4000, 4000, 4000, 4270, 0, 0, 0, 0, 0});
 		const int floorColumn[5] = {4255, 4265, 4270, 4280, 4290};
 		for (int r = 0; r < 5; r++) step.at(r, 5) = uint16_t(floorColumn[r]);
 		EXPECT_FALSE(DepthProjector::isFlyingPixel(step.view(), 2, 5, 1, tol));
-		// Without them (a dropout above and below, 4300 and 4310 diagonally:
-		// 30 and 40 mm away) it still has support: kept.
+		// Without them (a dropout above and below), the floor going on
+		// diagonally: 4300 and 4310 one pixel off (30 and 40 mm away), 4320 and
+		// 4330 two pixels off on the same diagonals (20 mm from those). Kept.
 		step.at(1, 5) = step.at(3, 5) = 0;
 		step.at(1, 6) = 4300;
 		step.at(3, 6) = 4310;
+		step.at(0, 7) = 4320;
+		step.at(4, 7) = 4330;
 		EXPECT_FALSE(DepthProjector::isFlyingPixel(step.view(), 2, 5, 1, tol));
+		// The diagonal neighbours alone, nothing two pixels off (a mixed
+		// pixel's neighbours at random depths can come that near): flying.
+		step.at(0, 7) = step.at(4, 7) = 0;
+		EXPECT_TRUE(DepthProjector::isFlyingPixel(step.view(), 2, 5, 1, tol));
 		// With no neighbour within 50 mm at all: flying.
 		step.at(1, 6) = step.at(3, 6) = 0;
 		EXPECT_TRUE(DepthProjector::isFlyingPixel(step.view(), 2, 5, 1, tol));

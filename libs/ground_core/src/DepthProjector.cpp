@@ -114,12 +114,15 @@ void DepthProjector::updateDecimatedLut(int dec)
 
 namespace
 {
-// A neighbour along the line within tol of the pixel: it lies on a surface
-// there (the far floor just past a step's edge continues along its row while
-// the column beyond it drops out; a mixed pixel has no such neighbour).
+// A neighbour along the line within tol of the pixel, and the next one on
+// that side within tol of it: a surface goes on there (the far floor just
+// past a step's edge continues along its row while the column beyond it
+// drops out). A mixed pixel's neighbours are other mixed pixels at random
+// depths: one of them may come within tol, two in a row rarely do.
 inline bool supportedAlong(const float* v, float tol)
 {
-	return (v[2] > 0 && std::abs(v[2] - v[3]) <= tol) || (v[4] > 0 && std::abs(v[4] - v[3]) <= tol);
+	const auto near = [tol](float a, float b) { return a > 0 && std::abs(a - b) <= tol; };
+	return (near(v[2], v[3]) && near(v[1], v[2])) || (near(v[4], v[3]) && near(v[5], v[4]));
 }
 
 // Both lines through pixel (r, c), neighbours `step` apart: h along its row,
@@ -166,21 +169,24 @@ bool flyingAt(const RangeImageView& img, int r, int c, int step, float tol)
 	if (!spreadOnEitherLine(h, w, tol)) return false;
 	if (flyingAlong(h, tol) || flyingAlong(w, tol)) return true;
 	if (!againstNothingAlong(h, tol) && !againstNothingAlong(w, tol)) return false;
-	// Against no return, a pixel must also stand alone: no neighbour of the
-	// 8 within tol of it. The floor just past a step's edge jumps as far (by
-	// the step's height over the camera's, 6 % for 5 cm from 0.8 m) and may
-	// have a dropout beyond it, but it continues along its row or diagonally;
-	// a mixed pixel's neighbours are the edge, the void and other mixed pixels
-	// at random depths.
+	// Against no return, a pixel must also stand alone: no surface goes on
+	// from it, i.e. no neighbour of the 8 within tol of it with the next
+	// pixel the same way within tol of that one. The floor just past a
+	// step's edge jumps as far (by the step's height over the camera's, 6 %
+	// for 5 cm from 0.8 m) and may have a dropout beyond it, but it continues
+	// along its row or diagonally; a mixed pixel's neighbours are the edge,
+	// the void and other mixed pixels at random depths, one of which may come
+	// within tol (which kept it, when one neighbour was enough).
 	const float d = h[3];
 	if (supportedAlong(h, tol) || supportedAlong(w, tol)) return false;
 	for (int dr = -1; dr <= 1; dr += 2)
 		for (int dc = -1; dc <= 1; dc += 2)
 		{
-			const int rr = r + dr * step, cc = c + dc * step;
+			// The diagonal neighbour and the next pixel on that diagonal.
+			const int rr = r + 2 * dr * step, cc = c + 2 * dc * step;
 			if (rr < 0 || cc < 0 || rr >= img.rows || cc >= img.cols) continue;
-			const float n = float(img.at(rr, cc));
-			if (n > 0 && std::abs(n - d) <= tol) return false;
+			const float n = float(img.at(r + dr * step, c + dc * step)), m = float(img.at(rr, cc));
+			if (n > 0 && std::abs(n - d) <= tol && m > 0 && std::abs(m - n) <= tol) return false;
 		}
 	return true;
 }
