@@ -344,10 +344,10 @@ bool InverseSensorModel::smeared(
 	double limit = std::numeric_limits<double>::infinity();
 	if (!drop && std::isfinite(m_rangeLimit))
 	{
-		const Eigen::Vector3d ray(dx, dy, dz);
+		// This sample's depth (or range), and what a metre along its ray adds.
 		const bool onRange = m_rangeAxis.isZero();
-		const double along = onRange ? r : ray.dot(m_rangeAxis);  // this sample's depth (range)
-		const double perMetre = onRange ? 1.0 : ray.dot(m_rangeAxis) / r;
+		const double along = onRange ? r : Eigen::Vector3d(dx, dy, dz).dot(m_rangeAxis);
+		const double perMetre = along / r;
 		if (perMetre > 0) limit = (m_rangeLimit - along) / perMetre * rho / r;
 	}
 	uint32_t last = cell;

@@ -138,8 +138,8 @@ class DepthProjector
 	 * continues neither that side nor a return just past the gap, and no
 	 * surface goes on from it: none of its 8 neighbours is within `tol` with
 	 * the next pixel the same way within `tol` of that one (the floor past a
-	 * step's edge goes on along its row). Depths and `tol` in the image's units; 0 = no return
-	 * (a side with a 0 predicts nothing). project() drops these pixels but
+	 * step's edge goes on along its row). Depths and `tol` in the image's
+	 * units; 0 = no return (a side with a 0 predicts nothing). project() drops these pixels but
 	 * for the second pixel of a pair that the side beyond its partner
 	 * continues linearly (|2 p1 - p2 - d| <= tol / 2): its fast first pass
 	 * keeps that one (5-13 pixels a frame on simulated Kinect One and Femto

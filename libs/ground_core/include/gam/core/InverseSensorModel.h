@@ -364,9 +364,9 @@ class InverseSensorModel
 	}
 	/** Where the frame's samples end: beyond `limit` [m] the camera (or the
 	 * projection's max_range) returned nothing. Measured along `forward`,
-	 * the camera's optical axis in the map frame (a depth image, cut on its
-	 * depth), or as the range from the sensor when `forward` is zero (a
-	 * range image or a point cloud). A surface just beyond the limit still
+	 * the camera's optical axis in the map frame as a unit vector (a depth
+	 * image, cut on its depth), or as the range from the sensor when
+	 * `forward` is zero (a range image or a point cloud). A surface just beyond the limit still
 	 * returns the samples its range noise brings nearer, and only those:
 	 * range_smear takes them for that surface's. Default: no limit. */
 	void setCameraRangeLimit(const Eigen::Vector3d& forward, double limit)
