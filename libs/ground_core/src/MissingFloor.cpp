@@ -298,7 +298,9 @@ void MissingFloorDetector::compute(
 			rayCount += statsRow;
 			emptyCount += empty;
 			int now = 0;
-			if (statsRow && grid.cell(cell).count > 0)
+			// (The ISM classified every cell this frame observed: its class,
+			// a byte, says what the cell's count says, 24 bytes each.)
+			if (statsRow && classes[cell] != VoxelClass::None)
 			{
 				// Seen floor (or whatever was seen there): its dropouts are the
 				// camera's, not a hole's.

@@ -140,7 +140,9 @@ class MissingFloorDetector
 	void setSecondImagerBaseline(double baseline) { m_baseline = baseline > 0 ? baseline : 0; }
 
 	/** One depth frame (frame.has_image) after the 2.5D map, the ground and
-	 * the ISM classes of that frame are known. `projector` holds the ray
+	 * the ISM classes of that frame are known (`classes`: None exactly for
+	 * the cells `grid` did not observe, as InverseSensorModel::classes()
+	 * gives them). `projector` holds the ray
 	 * table of frame.intrinsics (its project() ran on this frame);
 	 * `decimation` is the projection's; `maxRange` the range within which the
 	 * sensor returns floor (depth for depth images, range along the ray for
