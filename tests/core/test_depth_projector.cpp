@@ -901,6 +901,19 @@ std::vector<std::pair<int, int>> expectFilterKeepsTheUnflaggedPixels(const Image
 	return flagged;
 }
 
+namespace
+{
+// A pixel on the outline (`edge`) of a box face at 1.5 m in front of a
+// background `behind` mm away mixes the two with chance `mixChance`, at a
+// depth 15-85 % of the way back (as the simulator's flying pixels do);
+// otherwise it keeps its own depth `own`.
+double mixedOutlineDepth(double own, bool edge, double behind, double mixChance, std::mt19937& rng)
+{
+	std::uniform_real_distribution<double> u(0, 1);
+	return edge && u(rng) < mixChance ? 1500 + (0.15 + 0.7 * u(rng)) * (behind - 1500) : own;
+}
+}  // namespace
+
 TEST(DepthProjector, FlyingPixelFilterDropsExactlyTheFlyingPixels)
 {
 	// A wall at 3 m with a box face at 1.5 m in front of it, random mixed
@@ -910,7 +923,6 @@ TEST(DepthProjector, FlyingPixelFilterDropsExactlyTheFlyingPixels)
 	// FirstPassKeepsThePairedPixelThatOneSideContinues).
 	Image img;
 	std::mt19937 rng(7);
-	std::uniform_real_distribution<double> u(0, 1);
 	std::normal_distribution<double> noise(0, 3);
 	for (int r = 0; r < H; r++)
 		for (int c = 0; c < W; c++)
@@ -921,8 +933,7 @@ TEST(DepthProjector, FlyingPixelFilterDropsExactlyTheFlyingPixels)
 			// the range (no return, 0) and the outline mixes with 6 m.
 			const bool nothing = !box && c >= 44 && r < 24;
 			const double behind = nothing ? 6000 : 3000;
-			double mm = box ? 1500 : behind;
-			if (edge && u(rng) < 0.6) mm = 1500 + (0.15 + 0.7 * u(rng)) * (behind - 1500);
+			const double mm = mixedOutlineDepth(box ? 1500 : behind, edge, behind, 0.6, rng);
 			img.at(r, c) = nothing ? 0 : uint16_t(std::lround(mm + noise(rng)));
 		}
 	img.at(5, 5) = 0;  // a dropout
@@ -936,7 +947,6 @@ TEST(DepthProjector, FlyingPixelFilterAtTheImageEdgeIsTheSameTest)
 	// project() drops exactly the pixels isFlyingPixel() flags there too.
 	Image img;
 	std::mt19937 rng(11);
-	std::uniform_real_distribution<double> u(0, 1);
 	std::normal_distribution<double> noise(0, 3);
 	for (int r = 0; r < H; r++)
 		for (int c = 0; c < W; c++)
@@ -946,8 +956,7 @@ TEST(DepthProjector, FlyingPixelFilterAtTheImageEdgeIsTheSameTest)
 			// image's border rows and columns mix the two at random.
 			const bool box = r < 20 && c < 30;
 			const bool edge = (box && (r == 19 || c == 29)) || r < 3 || c < 3 || r >= H - 3 || c >= W - 3;
-			double mm = box ? 1500 : 3000;
-			if (edge && u(rng) < 0.3) mm = 1500 + (0.15 + 0.7 * u(rng)) * 1500;
+			const double mm = mixedOutlineDepth(box ? 1500 : 3000, edge, 3000, 0.3, rng);
 			img.at(r, c) = uint16_t(std::lround(mm + noise(rng)));
 		}
 	// Dropouts next to the border (a pixel beside one can be flying
