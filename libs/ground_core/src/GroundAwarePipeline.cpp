@@ -185,7 +185,7 @@ const FrameResult& GroundAwarePipeline::process(
 	m_ism.setCameraRangeLimit(
 		frame.has_image && frame.image.is_depth ? Eigen::Vector3d(frame.sensor_to_map.R.cast<double>().col(0))
 												: Eigen::Vector3d::Zero(),
-		std::min<double>(m_params.projection.max_range, frame.max_range));
+		sampleRangeLimit(frame, filter));
 	m_ism.compute(m_grid, m_result.detection, m_result.sensor, evidenceRange, m_result.ism, &m_bins);
 	const auto t4 = clk::now();
 

@@ -32,7 +32,7 @@ size_t binSensorFrame(
 	BinnedPoints& out)
 {
 	ProjectionFilter f = filter;
-	f.max_range = std::min(f.max_range, frame.max_range);
+	f.max_range = sampleRangeLimit(frame, filter);
 	if (frame.has_image) return projector.project(frame.image, frame.intrinsics, frame.sensor_to_map, f, grid, out);
 	return binPoints(frame.x, frame.y, frame.z, frame.point_count, frame.sensor_to_map, f, grid, out);
 }

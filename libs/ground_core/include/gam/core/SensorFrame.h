@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstddef>
 #include <limits>
 #include <string_view>
@@ -43,7 +44,15 @@ size_t binPoints(
 	const float* xs, const float* ys, const float* zs, size_t n, const RigidTransform& sensorToMap,
 	const ProjectionFilter& f, const ElevationGrid& grid, BinnedPoints& out);
 
-/** Bins every valid sample of `frame` (its max_range applied too) into `out`.
+/** Where binSensorFrame cuts `frame`'s samples: the nearer of the filter's
+ * max_range and the frame's [m], on the depth along the sensor's x axis for a
+ * depth image, on the range otherwise. */
+inline float sampleRangeLimit(const SensorFrame& frame, const ProjectionFilter& f)
+{
+	return std::min(f.max_range, frame.max_range);
+}
+
+/** Bins every valid sample of `frame` (up to sampleRangeLimit) into `out`.
  * Throws std::invalid_argument if its image and intrinsics disagree. */
 size_t binSensorFrame(
 	const SensorFrame& frame, const ProjectionFilter& f, const ElevationGrid& grid, DepthProjector& projector,
