@@ -139,11 +139,11 @@ class DepthProjector
 	 * surface goes on from it: none of its 8 neighbours is within `tol` with
 	 * the next pixel the same way within `tol` of that one (the floor past a
 	 * step's edge goes on along its row). Depths and `tol` in the image's
-	 * units; 0 = no return (a side with a 0 predicts nothing). project() drops these pixels but
-	 * for the second pixel of a pair that the side beyond its partner
-	 * continues linearly (|2 p1 - p2 - d| <= tol / 2): its fast first pass
-	 * keeps that one (5-13 pixels a frame on simulated Kinect One and Femto
-	 * frames, of the pixels this function flags). */
+	 * units; 0 = no return (a side with a 0 predicts nothing). project()
+	 * drops these pixels but for the second pixel of a pair that the side
+	 * beyond its partner continues linearly (|2 p1 - p2 - d| <= tol / 2): its
+	 * fast first pass keeps that one (5-13 pixels a frame on simulated Kinect
+	 * One and Femto frames, of the pixels this function flags). */
 	static bool isFlyingPixel(const RangeImageView& img, int row, int col, int step, float tol);
 
 	/** Whether the AVX2 row loop can run here (CPU and build). */
