@@ -1024,3 +1024,77 @@ TEST(DepthProjector, FirstPassKeepsThePairedPixelThatOneSideContinues)
 		}
 	}
 }
+
+TEST(DepthProjector, DecimatedFlyingFilterIsTheFullFilterOnTheDecimatedFrame)
+{
+	// With decimation 2, a 128x96 frame is its every other row and column: a
+	// 64x48 frame with fx, fy, cx, cy halved. fx = 100, cx = 63 here, and
+	// camera() has fx = 50, cx = 31.5: pixel 2k of the large camera has
+	// (2k - 63) / 100, pixel k of the small one (k - 31.5) / 50, the same
+	// real number, so the same double and the same rays bit for bit. The
+	// filter on the decimated frame must then drop exactly what it drops on
+	// the small frame, sample by sample; the odd rows and columns (random
+	// junk here) must play no part.
+	// The small frame: the box of FlyingPixelFilterDropsExactlyTheFlyingPixels
+	// (rows 0-31), and in rows 38-44 of every column the pair of
+	// FirstPassKeepsThePairedPixelThatOneSideContinues (0, 3839, 3788, 3760,
+	// 3696, 0, 3675): the full rule flags rows 40 and 41; the filter keeps
+	// row 41, which the side below continues (|2*3788 - 3839 - 3760| = 23
+	// <= 24). Reading the decimated frame pixel by pixel with neighbours 2
+	// apart (isFlyingPixel(step 2), what project() did before) drops it.
+	Image small;
+	std::mt19937 rng(5);
+	std::normal_distribution<double> noise(0, 3);
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+		{
+			const bool box = r >= 8 && r < 24 && c >= 20 && c < 44;
+			const bool edge = box && (r == 8 || r == 23 || c == 20 || c == 43);
+			const double mm = mixedOutlineDepth(box ? 1500 : 3000, edge, 3000, 0.6, rng);
+			small.at(r, c) = uint16_t(std::lround(mm + noise(rng)));
+		}
+	const uint16_t column[7] = {0, 3839, 3788, 3760, 3696, 0, 3675};
+	for (int r = 38; r <= 44; r++)
+		for (int c = 0; c < W; c++) small.at(r, c) = column[r - 38];
+	Image large(2 * H, 2 * W, 2 * W);
+	std::uniform_int_distribution<int> junk(0, 6000);
+	for (int r = 0; r < 2 * H; r++)
+		for (int c = 0; c < 2 * W; c++)
+			large.at(r, c) = r % 2 == 0 && c % 2 == 0 ? small.at(r / 2, c / 2) : uint16_t(junk(rng));
+	PinholeIntrinsics Klarge = camera();
+	Klarge.width = 2 * W;
+	Klarge.height = 2 * H;
+	Klarge.fx = Klarge.fy = 100;
+	Klarge.cx = 63;
+	Klarge.cy = 47;
+
+	const ElevationGrid grid(makeGeometry(-5, -5, 0.05, 200, 200));
+	const RigidTransform T = pose(pitchDown(10), {0, 0, 1.0});
+	ProjectionFilter f;
+	f.max_range = 10;
+	BinnedPoints all;
+	f.drop_flying_pixels = false;
+	DepthProjector().project(small.view(), camera(), T, f, grid, all);
+	f.drop_flying_pixels = true;
+	for (const bool avx2 : {true, false})
+	{
+		SCOPED_TRACE(avx2 ? "AVX2 (where the CPU has it)" : "baseline");
+		DepthProjector onSmall, decimated;
+		onSmall.setAllowAvx2(avx2);
+		decimated.setAllowAvx2(avx2);
+		BinnedPoints a, b;
+		f.decimation = 1;
+		onSmall.project(small.view(), camera(), T, f, grid, a);
+		f.decimation = 2;
+		decimated.project(large.view(), Klarge, T, f, grid, b);
+		ASSERT_GT(all.size(), a.size() + 20) << "the filter must drop the outline's mixed pixels";
+		ASSERT_EQ(a.size(), b.size());
+		for (size_t i = 0; i < a.size(); i++)
+		{
+			ASSERT_EQ(a.cells()[i], b.cells()[i]) << i;
+			ASSERT_EQ(a.heights()[i], b.heights()[i]) << i;
+		}
+	}
+	const float tol = float(0.05 / double(0.001f));
+	for (int c = 0; c < W; c++) EXPECT_TRUE(DepthProjector::isFlyingPixel(large.view(), 2 * 41, 2 * c, 2, tol)) << c;
+}

@@ -101,7 +101,7 @@ void DepthProjector::updateDecimatedLut(int dec)
 	m_decRayY.resize(rows * cols);
 	m_decRayZ.resize(rows * cols);
 	m_decRayInvNorm.resize(rows * cols);
-	m_decRow.resize(cols);
+	m_decImage.resize(rows * cols);
 	for (size_t r = 0; r < rows; r++)
 		for (size_t k = 0; k < cols; k++)
 		{
@@ -222,25 +222,24 @@ __attribute__((noinline)) bool gatherLinesAtEdge(
 	return true;
 }
 
-// Marks the flying pixels of row r (every dec-th column) in keep[k] = 0.
-// Without decimation a vector pass (flyingCandidates, ProjectRow.h) clears
-// every pixel that cannot be flying (but see flyingCandidatesIn on pairs);
-// only the few candidates left get the full test, in one vector loop over
-// the row's candidates (flyingLines). Beyond the image's edge both read 0,
-// as flyingAt does: the rows above the first and below the last are a row
-// of zeros, and a candidate within 3 pixels of the edge has its lines
-// gathered with 0 outside (gatherLinesAtEdge; the two pixels at each end of
-// a row are always candidates). Those border pixels went to flyingAt one at
-// a time before (2026-11-27, gam-bench, 3 + 3 alternating runs: projection
-// 0.597 -> 0.575 ms on the Kinect One demo, 0.989 -> 0.962 ms on the
-// Femto's). With decimation every pixel gets flyingAt.
-void markFlyingRow(
-	const RangeImageView& img, int r, int dec, float tol, bool avx2, uint8_t* keep, const FlyingBatch& batch)
+// Marks the flying pixels of row r in keep[c] = 0. A vector pass
+// (flyingCandidates, ProjectRow.h) clears every pixel that cannot be flying
+// (but see flyingCandidatesIn on pairs); only the few candidates left get
+// the full test, in one vector loop over the row's candidates
+// (flyingLines). Beyond the image's edge both read 0, as flyingAt does: the
+// rows above the first and below the last are a row of zeros, and a
+// candidate within 3 pixels of the edge has its lines gathered with 0
+// outside (gatherLinesAtEdge; the two pixels at each end of a row are always
+// candidates). Those border pixels went to flyingAt one at a time before
+// (2026-11-27, gam-bench, 3 + 3 alternating runs: projection 0.597 -> 0.575
+// ms on the Kinect One demo, 0.989 -> 0.962 ms on the Femto's). A decimated
+// frame comes here as its own smaller image (project()).
+void markFlyingRow(const RangeImageView& img, int r, float tol, bool avx2, uint8_t* keep, const FlyingBatch& batch)
 {
-	const int cols = img.cols, rows = img.rows, used = (cols + dec - 1) / dec;
-	if (dec != 1 || cols < 5)
+	const int cols = img.cols, rows = img.rows;
+	if (cols < 5)
 	{
-		for (int k = 0; k < used; k++) keep[k] = uint8_t(!flyingAt(img, r, k * dec, dec, tol));
+		for (int c = 0; c < cols; c++) keep[c] = uint8_t(!flyingAt(img, r, c, 1, tol));
 		return;
 	}
 	const uint16_t* row = img.data + size_t(r) * img.stride;
@@ -347,12 +346,34 @@ size_t DepthProjector::project(
 	p.nx_cells = g.nx;
 	p.units = img.units;
 
+	// With decimation n the frame is its every n-th row and column, a smaller
+	// camera's frame with its own ray table: the same row loop (same floats)
+	// and the same flying-pixel filter (neighbours n apart in the full
+	// frame) as at full resolution. The filter went pixel by pixel through
+	// flyingAt here before (2026-11-27, gam-bench, decimation 2: projection
+	// 1.00 ms on the Kinect One demo, more than at full resolution).
 	const int dec = std::max(1, f.decimation);
-	if (dec > 1) updateDecimatedLut(dec);
-	const size_t colsUsed = size_t((img.cols + dec - 1) / dec);
-	const size_t rowsUsed = size_t((img.rows + dec - 1) / dec);
+	RangeImageView src = img;
+	const float *rayY = m_rayY.data(), *rayZ = m_rayZ.data(), *rayInvNorm = m_rayInvNorm.data();
+	if (dec > 1)
+	{
+		updateDecimatedLut(dec);
+		src.cols = (img.cols + dec - 1) / dec;
+		src.rows = (img.rows + dec - 1) / dec;
+		src.stride = size_t(src.cols);
+		uint16_t* pixels = m_decImage.data();
+		for (int r = 0; r < src.rows; r++)
+		{
+			const uint16_t* row = img.data + size_t(r) * size_t(dec) * img.stride;
+			for (int k = 0; k < src.cols; k++) *pixels++ = row[size_t(k) * size_t(dec)];
+		}
+		src.data = m_decImage.data();
+		rayY = m_decRayY.data();
+		rayZ = m_decRayZ.data();
+		rayInvNorm = m_decRayInvNorm.data();
+	}
 	const size_t start = out.size();
-	out.prepare(colsUsed * rowsUsed);
+	out.prepare(size_t(src.cols) * size_t(src.rows));
 	uint32_t* outCell = out.cellBuffer();
 	float* outZ = out.zBuffer();
 	size_t n = start;
@@ -366,44 +387,24 @@ size_t DepthProjector::project(
 	const FlyingBatch flyingBatch{m_flyCols.data(),  m_flyLines.data(),          size_t(K.width),
 								  m_flyAlong.data(), m_flyAgainstNothing.data(), m_flyZeros.data()};
 
-	for (int r = 0; r < img.rows; r += dec)
+	for (int r = 0; r < src.rows; r++)
 	{
-		const size_t lutRow = size_t(r) * size_t(K.width);
-		const uint16_t* row = img.data + size_t(r) * img.stride;
-		if (dec == 1)
-		{
-			const float* invN = img.is_depth ? nullptr : &m_rayInvNorm[lutRow];
-			if (useAvx2)
-				detail::projectRowAvx2(
-					img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
-			else
-				projectRow(img.is_depth, p, row, &m_rayY[lutRow], &m_rayZ[lutRow], invN, img.cols, rowCell, rowZ);
-		}
+		const size_t lutRow = size_t(r) * size_t(src.cols);
+		const uint16_t* row = src.data + size_t(r) * src.stride;
+		const float* invN = src.is_depth ? nullptr : rayInvNorm + lutRow;
+		if (useAvx2)
+			detail::projectRowAvx2(src.is_depth, p, row, rayY + lutRow, rayZ + lutRow, invN, src.cols, rowCell, rowZ);
 		else
-		{
-			// Every dec-th pixel of the row, next to each other: then the
-			// same row loop (same floats) as at full resolution.
-			const int used = int(colsUsed);
-			const size_t decRow = size_t(r / dec) * colsUsed;
-			uint16_t* pixels = m_decRow.data();
-			for (int k = 0; k < used; k++) pixels[k] = row[size_t(k) * size_t(dec)];
-			const float* invN = img.is_depth ? nullptr : &m_decRayInvNorm[decRow];
-			if (useAvx2)
-				detail::projectRowAvx2(
-					img.is_depth, p, pixels, &m_decRayY[decRow], &m_decRayZ[decRow], invN, used, rowCell, rowZ);
-			else
-				projectRow(img.is_depth, p, pixels, &m_decRayY[decRow], &m_decRayZ[decRow], invN, used, rowCell, rowZ);
-		}
+			projectRow(src.is_depth, p, row, rayY + lutRow, rayZ + lutRow, invN, src.cols, rowCell, rowZ);
 		// Only the valid pixels (and, with the filter, the ones it keeps) go out.
 		const uint8_t* kept = nullptr;
 		if (f.drop_flying_pixels)
 		{
-			markFlyingRow(img, r, dec, flyTol, useAvx2, keep, flyingBatch);
+			markFlyingRow(src, r, flyTol, useAvx2, keep, flyingBatch);
 			kept = keep;
 		}
-		const int used = int(colsUsed);
-		n = useAvx2 ? detail::compactRowAvx2(rowCell, rowZ, kept, used, outCell, outZ, n)
-					: compactRow(rowCell, rowZ, kept, used, outCell, outZ, n);
+		n = useAvx2 ? detail::compactRowAvx2(rowCell, rowZ, kept, src.cols, outCell, outZ, n)
+					: compactRow(rowCell, rowZ, kept, src.cols, outCell, outZ, n);
 	}
 	out.commit(n);
 	return n - start;

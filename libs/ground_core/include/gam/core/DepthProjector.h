@@ -158,12 +158,12 @@ class DepthProjector
 	std::vector<float> m_rayY, m_rayZ;  // y/x and z/x
 	std::vector<float> m_rayInvNorm;    // 1 / |(1, y/x, z/x)|, for range images
 	std::vector<RayBounds> m_rowRayBounds;
-	// With decimation n > 1: the ray table of every n-th row and column
-	// (contiguous, so that the row loop runs on it unchanged) and one row's
-	// used pixels.
+	// With decimation n > 1: the ray table and the frame's pixels of every
+	// n-th row and column (contiguous: the row loop and the flying-pixel
+	// filter run on them as on a smaller camera's frame).
 	int m_decStep = 0;
 	std::vector<float> m_decRayY, m_decRayZ, m_decRayInvNorm;
-	std::vector<uint16_t> m_decRow;
+	std::vector<uint16_t> m_decImage;
 	// One row of results before compaction (cell or -1, z).
 	std::vector<int32_t> m_rowCell;
 	std::vector<float> m_rowZ;
