@@ -742,6 +742,7 @@ void InverseSensorModel::computePaper(
 	const double sx = sensor.x(), sy = sensor.y();
 	const paper::RayFan fan(res, m_maxRange);
 	const float floorP = ism::kEvidenceFloor;
+	const bool groundAtLeastFloor = float(m_params.K_g) >= floorP;
 
 	// 1. Classify every voxel in range (ground: both ends within d_pth); its
 	// own cell gets eq. (5) at |c| = |c_v|.
@@ -818,7 +819,10 @@ void InverseSensorModel::computePaper(
 			}
 			const double r = fan.radius(k);
 			float occ = 0.5f, fr = saturated ? floorP : 0.5f;
-			if (farGround >= r) fr = std::min(fr, float(paper::groundRay(r, farGround, m_params)));
+			// Ground evidence is at least K_g: once saturated at the floor, it
+			// cannot lower fr (most of a bin's samples, in front of a wall).
+			if (farGround >= r && !(saturated && groundAtLeastFloor))
+				fr = std::min(fr, float(paper::groundRay(r, farGround, m_params)));
 			for (size_t j = 0; j < m_paperActive.size();)
 			{
 				const float p =
