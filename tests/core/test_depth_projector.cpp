@@ -912,6 +912,29 @@ double mixedOutlineDepth(double own, bool edge, double behind, double mixChance,
 	std::uniform_real_distribution<double> u(0, 1);
 	return edge && u(rng) < mixChance ? 1500 + (0.15 + 0.7 * u(rng)) * (behind - 1500) : own;
 }
+
+// A wall at 3 m with a box face at 1.5 m in front of it (rows r0 to r1 - 1,
+// columns 20-43), the box's outline mixed at random (chance 0.6), 3 mm of
+// noise. With `nothingRight`, right of the box in the image's upper half the
+// background is beyond the range (no return, 0) and the outline there mixes
+// with 6 m.
+Image boxInFrontOfWall(int r0, int r1, unsigned seed, bool nothingRight)
+{
+	Image img;
+	std::mt19937 rng(seed);
+	std::normal_distribution<double> noise(0, 3);
+	for (int r = 0; r < H; r++)
+		for (int c = 0; c < W; c++)
+		{
+			const bool box = r >= r0 && r < r1 && c >= 20 && c < 44;
+			const bool edge = box && (r == r0 || r == r1 - 1 || c == 20 || c == 43);
+			const bool nothing = nothingRight && !box && c >= 44 && r < H / 2;
+			const double behind = nothing ? 6000 : 3000;
+			const double mm = mixedOutlineDepth(box ? 1500 : behind, edge, behind, 0.6, rng);
+			img.at(r, c) = nothing ? 0 : uint16_t(std::lround(mm + noise(rng)));
+		}
+	return img;
+}
 }  // namespace
 
 TEST(DepthProjector, FlyingPixelFilterDropsExactlyTheFlyingPixels)
@@ -920,22 +943,9 @@ TEST(DepthProjector, FlyingPixelFilterDropsExactlyTheFlyingPixels)
 	// pixels on the box's outline and noise: project() with the filter keeps
 	// the pixels its own projection keeps minus those isFlyingPixel() flags
 	// (on this image the fast first pass loses none; where it does, see
-	// FirstPassKeepsThePairedPixelThatOneSideContinues).
-	Image img;
-	std::mt19937 rng(7);
-	std::normal_distribution<double> noise(0, 3);
-	for (int r = 0; r < H; r++)
-		for (int c = 0; c < W; c++)
-		{
-			const bool box = r >= 12 && r < 36 && c >= 20 && c < 44;
-			const bool edge = box && (r == 12 || r == 35 || c == 20 || c == 43);
-			// Right of the box, in its upper half, the background is beyond
-			// the range (no return, 0) and the outline mixes with 6 m.
-			const bool nothing = !box && c >= 44 && r < 24;
-			const double behind = nothing ? 6000 : 3000;
-			const double mm = mixedOutlineDepth(box ? 1500 : behind, edge, behind, 0.6, rng);
-			img.at(r, c) = nothing ? 0 : uint16_t(std::lround(mm + noise(rng)));
-		}
+	// FirstPassKeepsThePairedPixelThatOneSideContinues). Right of the box,
+	// in its upper half, the background is beyond the range.
+	Image img = boxInFrontOfWall(12, 36, 7, true);
 	img.at(5, 5) = 0;  // a dropout
 	EXPECT_GT(expectFilterKeepsTheUnflaggedPixels(img).size(), 20u) << "the outline's mixed pixels";
 }
@@ -1035,28 +1045,19 @@ TEST(DepthProjector, DecimatedFlyingFilterIsTheFullFilterOnTheDecimatedFrame)
 	// filter on the decimated frame must then drop exactly what it drops on
 	// the small frame, sample by sample; the odd rows and columns (random
 	// junk here) must play no part.
-	// The small frame: the box of FlyingPixelFilterDropsExactlyTheFlyingPixels
-	// (rows 0-31), and in rows 38-44 of every column the pair of
+	// The small frame: a box in front of a wall (rows 8-23, its outline
+	// mixed), and in rows 38-44 of every column the pair of
 	// FirstPassKeepsThePairedPixelThatOneSideContinues (0, 3839, 3788, 3760,
 	// 3696, 0, 3675): the full rule flags rows 40 and 41; the filter keeps
 	// row 41, which the side below continues (|2*3788 - 3839 - 3760| = 23
 	// <= 24). Reading the decimated frame pixel by pixel with neighbours 2
 	// apart (isFlyingPixel(step 2), what project() did before) drops it.
-	Image small;
-	std::mt19937 rng(5);
-	std::normal_distribution<double> noise(0, 3);
-	for (int r = 0; r < H; r++)
-		for (int c = 0; c < W; c++)
-		{
-			const bool box = r >= 8 && r < 24 && c >= 20 && c < 44;
-			const bool edge = box && (r == 8 || r == 23 || c == 20 || c == 43);
-			const double mm = mixedOutlineDepth(box ? 1500 : 3000, edge, 3000, 0.6, rng);
-			small.at(r, c) = uint16_t(std::lround(mm + noise(rng)));
-		}
+	Image small = boxInFrontOfWall(8, 24, 5, false);
 	const uint16_t column[7] = {0, 3839, 3788, 3760, 3696, 0, 3675};
 	for (int r = 38; r <= 44; r++)
 		for (int c = 0; c < W; c++) small.at(r, c) = column[r - 38];
 	Image large(2 * H, 2 * W, 2 * W);
+	std::mt19937 rng(5);
 	std::uniform_int_distribution<int> junk(0, 6000);
 	for (int r = 0; r < 2 * H; r++)
 		for (int c = 0; c < 2 * W; c++)
