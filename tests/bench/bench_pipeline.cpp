@@ -7,28 +7,34 @@
 // cycles through them. After the cases, a summary prints median and p95 ms
 // per frame of the whole pipeline and of height_band / octomap on the same
 // frames, and the ratios; then the ground-aware grid's stages (median / p95);
-// with --full-octomap=M, also the octomap fed every pixel (first M frames).
+// where height_band's time goes (MRPT's convertTo2DScan, the scan's insertion)
+// next to the same band as a plain loop; with --full-octomap=M, also the
+// octomap fed every pixel (first M frames).
 #include <benchmark/benchmark.h>
 #include <gam/core/CameraNoise.h>
 #include <gam/maps/ObservationAdapters.h>
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/maps/COctoMapGrid2D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CRawlog.h>
+#include <mrpt/obs/T3DPointsTo2DScanParams.h>
 #include <mrpt/system/filesystem.h>
 #include "gam/core/CameraNoise.h"
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -201,6 +207,74 @@ std::string cpuName()
 	return name.empty() ? std::string("unknown CPU") : name + ", " + std::to_string(cpus) + " CPUs";
 }
 
+// Where height_band's time goes, frame by frame: MRPT's
+// CObservation3DRangeScan::convertTo2DScan() (what the map calls), the
+// virtual scan's insertion into a COccupancyGridMap2D, and, for scale, the
+// same band as a plain loop: each pixel unprojected (MRPT's convention) into
+// the robot frame, kept if its z is in the band, binned by its bearing
+// (atan2 per kept point, as ROS pointcloud_to_laserscan does), the nearest
+// horizontal range per bin. No map: the scan it makes is not inserted.
+struct HeightBandSplit
+{
+	std::vector<double> convert, insert, plainLoop;
+};
+HeightBandSplit heightBandSplit(const Dataset& d, int rounds)
+{
+	const CHeightBandOccupancyGrid band;  // its default band and oversampling
+	const auto& bo = band.bandOptions;
+	COccupancyGridMap2D grid(band.getXMin(), band.getXMax(), band.getYMin(), band.getYMax(), band.getResolution());
+	grid.insertionOptions.considerInvalidRangesAsFreeSpace = false;
+	grid.insertionOptions.horizontalTolerance = mrpt::DEG2RAD(10.0f);
+	HeightBandSplit out;
+	std::vector<float> nearest;
+	const auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+	for (int r = 0; r < rounds; r++)
+		for (const Frame& f : d.frames)
+		{
+			CObservation3DRangeScan& o = *f.depth;
+			T3DPointsTo2DScanParams sp;
+			sp.sensorLabel = o.sensorLabel;
+			sp.use_origin_sensor_pose = true;
+			sp.z_min = bo.z_min;
+			sp.z_max = bo.z_max;
+			sp.oversampling_ratio = bo.oversampling_ratio;
+			CObservation2DRangeScan scan;
+			const auto t0 = std::chrono::steady_clock::now();
+			o.convertTo2DScan(scan, sp);
+			const auto t1 = std::chrono::steady_clock::now();
+			grid.insertObservation(scan, f.pose);
+			const auto t2 = std::chrono::steady_clock::now();
+
+			const int W = int(o.rangeImage.cols()), H = int(o.rangeImage.rows());
+			const double fx = o.cameraParams.fx(), fy = o.cameraParams.fy();
+			const double cx = o.cameraParams.cx(), cy = o.cameraParams.cy();
+			const auto R = o.sensorPose.getRotationMatrix();
+			const double tz = o.sensorPose.z();
+			const int bins = std::max(1, int(W * bo.oversampling_ratio));
+			const double a0 = -std::atan(W / (2 * fx)), da = -2 * a0 / bins;
+			nearest.assign(size_t(bins), std::numeric_limits<float>::infinity());
+			for (int row = 0; row < H; row++)
+				for (int col = 0; col < W; col++)
+				{
+					const uint16_t v = o.rangeImage(row, col);
+					if (!v) continue;
+					const double X = v * double(o.rangeUnits), Y = (cx - col) * X / fx, Z = (cy - row) * X / fy;
+					const double z = R(2, 0) * X + R(2, 1) * Y + R(2, 2) * Z + tz;
+					if (z < bo.z_min || z > bo.z_max) continue;
+					const double x = R(0, 0) * X + R(0, 1) * Y + R(0, 2) * Z,
+								 y = R(1, 0) * X + R(1, 1) * Y + R(1, 2) * Z;
+					const int b = int((std::atan2(y, x) - a0) / da);
+					if (b >= 0 && b < bins) nearest[size_t(b)] = std::min(nearest[size_t(b)], float(std::hypot(x, y)));
+				}
+			benchmark::DoNotOptimize(nearest.data());
+			const auto t3 = std::chrono::steady_clock::now();
+			out.convert.push_back(ms(t0, t1));
+			out.insert.push_back(ms(t1, t2));
+			out.plainLoop.push_back(ms(t2, t3));
+		}
+	return out;
+}
+
 // Single-frame rawlogs are inserted repeatedly: about 40 insertions per map.
 int roundsFor(const Dataset& d) { return std::max(1, int(40 / d.frames.size())); }
 }  // namespace
@@ -327,6 +401,20 @@ int main(int argc, char** argv)
 				camera, mp(t.projection).c_str(), mp(t.outliers).c_str(), mp(t.ground).c_str(), mp(t.ism).c_str(),
 				mp(t.missing).c_str(), mp(t.update).c_str(), mp(t.total).c_str());
 		}
+
+	std::printf(
+		"\nheight_band's time, median / p95 ms: MRPT's convertTo2DScan() and the virtual scan's insertion (what the "
+		"map does), and the same band as a plain loop over the pixels (no map; see heightBandSplit):\n\n| data | "
+		"convertTo2DScan | scan insertion | plain loop | ground_aware median | plain loop / ground_aware "
+		"|\n|---|---|---|---|---|---|\n");
+	for (size_t k = 0; k < g_data.size(); k++)
+	{
+		const HeightBandSplit hs = heightBandSplit(g_data[k], roundsFor(g_data[k]));
+		std::printf(
+			"| %s | %s | %s | %s | %.2f | %.2fx |\n", g_data[k].name.c_str(), mp(hs.convert).c_str(),
+			mp(hs.insert).c_str(), mp(hs.plainLoop).c_str(), groundAwareMedian[k],
+			quantile(hs.plainLoop, 0.5) / groundAwareMedian[k]);
+	}
 
 	if (fullOctomapFrames > 0)
 	{
