@@ -22,7 +22,6 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CRawlog.h>
-#include <mrpt/obs/T3DPointsTo2DScanParams.h>
 #include <mrpt/system/filesystem.h>
 #include "gam/core/CameraNoise.h"
 
@@ -232,12 +231,7 @@ HeightBandSplit heightBandSplit(const Dataset& d, int rounds)
 		for (const Frame& f : d.frames)
 		{
 			CObservation3DRangeScan& o = *f.depth;
-			T3DPointsTo2DScanParams sp;
-			sp.sensorLabel = o.sensorLabel;
-			sp.use_origin_sensor_pose = true;
-			sp.z_min = bo.z_min;
-			sp.z_max = bo.z_max;
-			sp.oversampling_ratio = bo.oversampling_ratio;
+			const T3DPointsTo2DScanParams sp = band.scanParams(o.sensorLabel);
 			CObservation2DRangeScan scan;
 			const auto t0 = std::chrono::steady_clock::now();
 			o.convertTo2DScan(scan, sp);

@@ -106,6 +106,17 @@ std::string CHeightBandOccupancyGrid::asString() const
 	return s.str();
 }
 
+mrpt::obs::T3DPointsTo2DScanParams CHeightBandOccupancyGrid::scanParams(const std::string& sensorLabel) const
+{
+	mrpt::obs::T3DPointsTo2DScanParams sp;
+	sp.sensorLabel = sensorLabel;
+	sp.use_origin_sensor_pose = true;
+	sp.z_min = bandOptions.z_min;
+	sp.z_max = bandOptions.z_max;
+	sp.oversampling_ratio = bandOptions.oversampling_ratio;
+	return sp;
+}
+
 bool CHeightBandOccupancyGrid::internal_insertObservation(
 	const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose)
 {
@@ -119,14 +130,8 @@ bool CHeightBandOccupancyGrid::internal_insertObservation(
 		// MRPT trusts the intrinsics, image size and units: check them here.
 		gam::maps::checkRangeScan(o3);
 		gam::maps::checkScanGrowth(*this, pose + o3.sensorPose);
-		T3DPointsTo2DScanParams sp;
-		sp.sensorLabel = o3.sensorLabel;
-		sp.use_origin_sensor_pose = true;
-		sp.z_min = bandOptions.z_min;
-		sp.z_max = bandOptions.z_max;
-		sp.oversampling_ratio = bandOptions.oversampling_ratio;
 		m_lastScan = CObservation2DRangeScan();
-		o3.convertTo2DScan(m_lastScan, sp);
+		o3.convertTo2DScan(m_lastScan, scanParams(o3.sensorLabel));
 		m_hasLastScan = true;
 		if (m_lastScan.getScanSize() == 0) return false;
 		m_lastScan = gam::maps::safeScanFor(*this, m_lastScan, pose);

@@ -5,6 +5,7 @@
 #include <mrpt/maps/COccupancyGridMap2D.h>
 
 #include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/T3DPointsTo2DScanParams.h>
 #include "gam/core/Parameters.h"
 
 namespace mrpt::maps
@@ -62,6 +63,10 @@ class CHeightBandOccupancyGrid : public COccupancyGridMap2D
 
 	/** The virtual scan made from the last 3D observation (robot frame). */
 	const mrpt::obs::CObservation2DRangeScan* lastVirtualScan() const { return m_hasLastScan ? &m_lastScan : nullptr; }
+	/** What the map passes to CObservation3DRangeScan::convertTo2DScan() for a
+	 * frame of sensor `sensorLabel`: bandOptions, robot-frame z, the sensor's
+	 * own pose on the robot. */
+	mrpt::obs::T3DPointsTo2DScanParams scanParams(const std::string& sensorLabel) const;
 
 	std::string asString() const override;
 
