@@ -278,6 +278,22 @@ TEST(NoAlloc, GroundAwareGridSyntheticFrameSteadyState)
 	EXPECT_EQ(worst, 0u) << "heap allocations per frame after warm-up; run with GAM_ALLOC_TRACE=1 to see where";
 }
 
+TEST(NoAlloc, GroundAwareGridDecimatedFrameSteadyState)
+{
+	// decimation = 2: the decimated frame and its ray table are built on the
+	// first frame and reused (the flying-pixel filter runs on that frame).
+	CGroundAwareOccupancyGrid grid;
+	auto o = grid.groundOptions();
+	o.pipeline.projection.decimation = 2;
+	grid.setGroundOptions(o);
+	std::vector<CObservation3DRangeScan::Ptr> frames{syntheticFrame()};
+	size_t total = 0;
+	const size_t worst = maxAllocsPerFrame(grid, frames, total);
+	std::cout << "[alloc] synthetic, decimation 2: " << total << " allocations in " << kMeasured
+			  << " frames (worst frame " << worst << ")\n";
+	EXPECT_EQ(worst, 0u) << "heap allocations per frame after warm-up; run with GAM_ALLOC_TRACE=1 to see where";
+}
+
 TEST(NoAlloc, GroundAwareGridRealAndSyntheticFramesSteadyState)
 {
 	auto real = firstScan("mrpt_3d_obs_ground/test-3d-obs-ground.rawlog");
