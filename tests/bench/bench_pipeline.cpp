@@ -16,7 +16,6 @@
 #include <mrpt/maps/CGroundAwareOccupancyGrid.h>
 
 #include <mrpt/maps/CHeightBandOccupancyGrid.h>
-#include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/maps/COctoMapGrid2D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -208,7 +207,7 @@ std::string cpuName()
 
 // Where height_band's time goes, frame by frame: MRPT's
 // CObservation3DRangeScan::convertTo2DScan() (what the map calls), the
-// virtual scan's insertion into a COccupancyGridMap2D, and, for scale, the
+// virtual scan's insertion into the map, and, for scale, the
 // same band as a plain loop: each pixel unprojected (MRPT's convention) into
 // the robot frame, kept if its z is in the band, binned by its bearing
 // (atan2 per kept point, as ROS pointcloud_to_laserscan does), the nearest
@@ -219,11 +218,10 @@ struct HeightBandSplit
 };
 HeightBandSplit heightBandSplit(const Dataset& d, int rounds)
 {
-	const CHeightBandOccupancyGrid band;  // its default band and oversampling
+	// Its default band, oversampling and insertion options; a 2D scan goes
+	// into it as the virtual scan does after the conversion.
+	CHeightBandOccupancyGrid band;
 	const auto& bo = band.bandOptions;
-	COccupancyGridMap2D grid(band.getXMin(), band.getXMax(), band.getYMin(), band.getYMax(), band.getResolution());
-	grid.insertionOptions.considerInvalidRangesAsFreeSpace = false;
-	grid.insertionOptions.horizontalTolerance = mrpt::DEG2RAD(10.0f);
 	HeightBandSplit out;
 	std::vector<float> nearest;
 	const auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
@@ -236,7 +234,7 @@ HeightBandSplit heightBandSplit(const Dataset& d, int rounds)
 			const auto t0 = std::chrono::steady_clock::now();
 			o.convertTo2DScan(scan, sp);
 			const auto t1 = std::chrono::steady_clock::now();
-			grid.insertObservation(scan, f.pose);
+			band.insertObservation(scan, f.pose);
 			const auto t2 = std::chrono::steady_clock::now();
 
 			const int W = int(o.rangeImage.cols()), H = int(o.rangeImage.rows());
