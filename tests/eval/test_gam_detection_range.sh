@@ -37,6 +37,12 @@ grep -qx "# commit: smoke" "$w/single.csv" || fail "CSV names the commit"
 grep -q '^hole_0.30x0.05,hole,0.3,0.05,kinect_one,4.5,5.0,4.5,single,ground_aware,1,' "$w/single.csv" ||
 	fail "CSV limit columns"
 [[ -s "$w/single/detections.csv" && -s "$w/single/tables.md" ]] || fail "--out files"
+# Issue #27's verdict: 0.9 x the limit, 0.9 * 2.667 = 2.40 m and 0.9 * 4.5 = 4.05 m; ranges 1.0
+# and 4.0 m reach neither, whatever the noise.
+v="$(grep '^single: every hazard out to >= 0.9 x its limit (issue #27): 0: -; miss it: 2: ' "$w/single.txt")" ||
+	fail "issue #27 verdict line"
+grep -Eq 'hole_0\.10x0\.05 \((1\.00|4\.00|-) of 2\.40\)' <<<"$v" || fail "issue #27 verdict: 10 cm hole needs 2.40 m"
+grep -Eq 'hole_0\.30x0\.05 \((1\.00|4\.00|-) of 4\.05\)' <<<"$v" || fail "issue #27 verdict: 30 cm hole needs 4.05 m"
 
 "$tool" --build "$build" --camera d435 --maps ground_aware --modes single --objects '^hole_0\.30x0\.05$' \
 	--ranges "1.5" --seeds 1 --csv "$w/d435.csv" --commit smoke >"$w/d435.txt" 2>"$w/d435.err" ||
