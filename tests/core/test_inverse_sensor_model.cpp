@@ -353,7 +353,9 @@ namespace
 // 1.432219 (the cells' means of a few mm below 0 move it by < 3 mm, which
 // moves T by < 0.01 mm); one sample's vertical noise sigma = (0.0012 +
 // 0.0019 r^2) / r = 0.0050974 / 1.432219 = 0.0035591; tau = d_pth / 3 = 0.01;
-// s = sqrt(sigma^2 + tau^2) = 0.0106145; T = max(0.02, 3 s) = 0.0318436.
+// s = sqrt(sigma^2 + tau^2) = 0.0106145; T = max(0.02, 3 s) = 0.0318436 for a
+// camera whose samples share part of their error (sharedNoise() below); with
+// independent samples (the default camera) T is traversable_step = 0.02.
 constexpr double kDeepX = 1.025, kDeepY = 0.025;
 double handDeepThreshold()
 {
@@ -361,6 +363,11 @@ double handDeepThreshold()
 	const double sigma = (0.0012 + 0.0019 * r * r) / r;
 	return std::max(0.02, 3.0 * std::sqrt(sigma * sigma + 0.01 * 0.01));
 }
+/** The D435's noise preset: a correlated part, so the deep-sample threshold
+ * is max(traversable_step, 3 s). (The vertical sigma of these tests stays the
+ * IsmParams model's: the camera's noise only says whether samples share an
+ * error, and feeds range_smear.) */
+void shareNoise(InverseSensorModel& ism) { ism.setCameraNoise(cameraNoisePreset(CameraModel::D435), 600); }
 IsmParams deepParams()
 {
 	IsmParams p;
@@ -390,6 +397,7 @@ TEST(InverseSensorModel, DeepSamplesBeyondTheFloorNoiseMakeADrop)
 	ASSERT_NEAR(T, 0.0318436, 1e-6);
 	const float below = float(-T - 0.001), above = float(-T + 0.001);
 	InverseSensorModel ism(deepParams());
+	shareNoise(ism);
 	IsmStats st;
 	BinnedPoints b;
 	auto classOf = [&](const ElevationGrid& f, const BinnedPoints* samples) {
@@ -413,6 +421,7 @@ TEST(InverseSensorModel, DeepSamplesBeyondTheFloorNoiseMakeADrop)
 	IsmParams off = deepParams();
 	off.deep_sample_test = false;
 	InverseSensorModel noDeep(off);
+	shareNoise(noDeep);
 	noDeep.compute(three, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
 	EXPECT_EQ(st.ground, 1u);
 	EXPECT_EQ(st.deep_drops, 0u);
@@ -425,6 +434,42 @@ TEST(InverseSensorModel, DeepSamplesBeyondTheFloorNoiseMakeADrop)
 	EXPECT_EQ(classOf(two, &b), VoxelClass::Ground);
 }
 
+TEST(InverseSensorModel, WithIndependentSamplesTheDeepThresholdIsTheTraversableStep)
+{
+	// The default camera's samples are independent: the binomial tail is
+	// exact at any threshold, and T = traversable_step = 0.02 counts the most
+	// of a hole's wall. By hand (the cell of handDeepThreshold: s =
+	// 0.0106145): p0 = Phi(-0.02 / 0.0106145) = Phi(-1.884220) = 0.029768.
+	// Among n = 30: P(X >= 5) = 0.00179 > Phi(-3) = 0.00135 (floor), P(X >= 6)
+	// = 0.000223 < 0.00135 (a drop). Samples at -0.021, 1 mm below T and
+	// 1.1 cm above the 3 s threshold (0.0318) that a shared-noise camera uses.
+	const double p0 = ism::normalTail(0.02 / 0.0106145);
+	EXPECT_NEAR(p0, 0.029768, 1e-6);
+	EXPECT_NEAR(ism::binomialTail(30, p0, 5), 0.00179, 0.00001);
+	EXPECT_NEAR(ism::binomialTail(30, p0, 6), 0.000223, 0.000001);
+	InverseSensorModel ism(deepParams());
+	IsmStats st;
+	BinnedPoints b;
+	const ElevationGrid five = deepCellFrame(25, std::vector<float>(5, -0.021f), b);
+	ism.compute(five, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 0u);
+	EXPECT_EQ(st.ground, 1u);
+	const ElevationGrid six = deepCellFrame(24, std::vector<float>(6, -0.021f), b);
+	ism.compute(six, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 1u);
+	EXPECT_EQ(st.drop, 1u);
+	// 1 mm above T, the same six do not count.
+	const ElevationGrid shallow = deepCellFrame(24, std::vector<float>(6, -0.019f), b);
+	ism.compute(shallow, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 0u);
+	// A camera with shared noise keeps T = 3 s = 0.0318: the six lie above it.
+	InverseSensorModel shared(deepParams());
+	shareNoise(shared);
+	shared.compute(six, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+	EXPECT_EQ(st.deep_drops, 0u);
+	EXPECT_EQ(st.ground, 1u);
+}
+
 TEST(InverseSensorModel, DeepSampleCountIsJudgedAgainstTheCellsSampleCount)
 {
 	// The same 3 deep samples among n = 300: floor noise gives P(X >= 3) with
@@ -435,6 +480,7 @@ TEST(InverseSensorModel, DeepSampleCountIsJudgedAgainstTheCellsSampleCount)
 	EXPECT_NEAR(ism::binomialTail(300, ism::normalTail(3.0), 3), 0.0081, 0.0001);
 	const float below = float(-handDeepThreshold() - 0.001);
 	InverseSensorModel ism(deepParams());
+	shareNoise(ism);
 	IsmStats st;
 	BinnedPoints b;
 	const ElevationGrid three = deepCellFrame(297, std::vector<float>(3, below), b);
@@ -473,8 +519,8 @@ TEST(InverseSensorModel, ACellThatSitsLowAsAWholeHasNoDeepDropWithAStereoCamera)
 	std::vector<float> samples(24, -0.026f);
 	samples.insert(samples.end(), 6, -0.0328f);
 	const ElevationGrid low = deepCellFrame(0, samples, b);
-	// A time-of-flight camera (independent samples, the default): the plane's
-	// p0 alone, a drop.
+	// A time-of-flight camera (independent samples, the default): T = 0.02,
+	// all 30 samples lie below it, p0 = Phi(-0.02 / s) = 0.0299: a drop.
 	InverseSensorModel tof(deepParams());
 	tof.compute(low, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
 	EXPECT_EQ(st.deep_drops, 1u);
@@ -503,6 +549,7 @@ TEST(InverseSensorModel, DeepSamplesRejectedByTheThreeSigmaRuleDoNotCount)
 	// of the unfiltered samples would have made it a drop.
 	const float below = float(-handDeepThreshold() - 0.001);
 	InverseSensorModel ism(deepParams());
+	shareNoise(ism);
 	IsmStats st;
 	BinnedPoints b;
 	const ElevationGrid f = deepCellFrame(60, {below, below, -0.3f, -0.3f, -0.3f}, b, true);

@@ -584,7 +584,12 @@ void InverseSensorModel::compute(
 				const double k = m_params.noise_sigmas, sigma = (band - m_params.d_pth) / k;
 				const double t = tau >= 0 ? tau : m_params.d_pth / k;
 				const double s = std::sqrt(sigma * sigma + t * t);
-				const double T = std::max(m_params.traversable_step, k * s);
+				// Where the samples' errors are independent, the binomial tail
+				// is exact at any threshold, and one at the smallest hazard's
+				// own size counts the most of a hole's wall; a shared error
+				// moves whole groups of samples together, so there only the
+				// band's 3 sigma (or the step, if larger) is deep enough.
+				const double T = sharedNoise ? std::max(m_params.traversable_step, k * s) : m_params.traversable_step;
 				if (s > 0 && pl.signedDistance(x, y, c.z_min) < -T && pl.c > 0)
 				{
 					// signedDistance = c (z - heightAt) for a unit normal.

@@ -70,8 +70,13 @@ struct IsmParams
 	 * camera sees from 0 down to w h / r: the mean of the cell stays near the
 	 * floor and its deepest sample inside the one-sample band, yet dozens of
 	 * its samples lie deeper than any floor sample would. A floor sample lies
-	 * more than T = max(traversable_step, noise_sigmas * s) below the plane
-	 * with probability p0 = Phi(-T / s) (s^2 = sigma^2 + tau^2: one sample's
+	 * more than T below the plane with probability p0 = Phi(-T / s), where T
+	 * = traversable_step for a camera whose samples are independent (time of
+	 * flight: the binomial tail is then exact at any T, and the hazard's own
+	 * size counts the most of a hole's wall) and T = max(traversable_step,
+	 * noise_sigmas * s) for one whose samples share part of their error
+	 * (active stereo, structured light: a whole group of samples moves
+	 * together, so only the band's depth is safe) (s^2 = sigma^2 + tau^2: one sample's
 	 * vertical noise and the measured spread of the cells' means, d_pth /
 	 * noise_sigmas where unmeasured); a cell whose k such samples (of the N
 	 * the 3-sigma rule kept) have P(Binomial(N, p0) >= k) < Phi(-noise_sigmas),
