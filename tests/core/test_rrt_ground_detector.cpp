@@ -528,3 +528,68 @@ TEST(RrtGroundDetector, PatchSlopeWeighsNodeCentresAndLocalPlanesByTheirPrecisio
 	EXPECT_NEAR(exact.x(), 0.12, 1e-12);
 	EXPECT_NEAR(exact.y(), -0.03, 1e-12);
 }
+
+namespace
+{
+GroundNode nodeAt(double x, double y, double z)
+{
+	GroundNode n;
+	n.x = float(x);
+	n.y = float(y);
+	n.z = float(z);
+	return n;
+}
+}  // namespace
+
+TEST(RrtGroundDetector, APatchMeetsTheFloorOnlyWithoutAStep)
+{
+	const Plane floor{0, 0, 1, 0};  // z = 0
+	// 1. The lower level of a 5 cm step 4 m from a Kinect One (traced on a
+	// detection-range frame): its plane tilted 2.3 deg toward the floor by
+	// the nodes next to the edge. By hand, heightAt = -(a x + b y + d) / c:
+	// at p (4.275, 0.125): (0.1335 - 0.1731375 - 0.0012625) / 0.9991 =
+	// -0.040937; at the floor node q (4.125, 0.125, z -0.013): (0.1335 -
+	// 0.1670625 - 0.0012625) / 0.9991 = -0.034856. No sign change, 4.1 and
+	// 3.5 cm below the floor (tol 2 cm), 2.2 cm below q itself, not above
+	// the floor: no junction. (The band at a ground node was tol + 2.5 cm =
+	// 4.5 cm before, which took it.)
+	const Plane step{0.0405, 0.0101, 0.9991, -0.1335};
+	EXPECT_NEAR(step.heightAt(4.275, 0.125), -0.040937, 1e-6);
+	EXPECT_NEAR(step.heightAt(4.125, 0.125), -0.034856, 1e-6);
+	EXPECT_FALSE(patchMeetsPlaneBetween(
+		step, floor, nodeAt(4.275, 0.125, -0.040), nodeAt(4.125, 0.125, -0.013), true, 0.02, 0.02));
+
+	// 2. A 6 deg ramp from x = 1 (tan 6 deg = 0.105104): z = 0.105104 (x - 1).
+	// A ground-plane node already on the ramp at x = 1.25 (z 0.0263, the
+	// ramp's 0.026276 there): 2.6 cm above the floor, beyond tol, but the
+	// patch passes through it: a junction. A floor node at the same place
+	// (z 0) has the patch 2.6 cm above it, a step up higher than 2 cm: none.
+	const Plane ramp{-0.105104, 0, 1, 0.105104};
+	EXPECT_NEAR(ramp.heightAt(1.25, 0), 0.026276, 1e-6);
+	const GroundNode onRamp = nodeAt(1.45, 0, ramp.heightAt(1.45, 0));
+	EXPECT_TRUE(patchMeetsPlaneBetween(ramp, floor, onRamp, nodeAt(1.25, 0, 0.0263), true, 0.02, 0.02));
+	EXPECT_FALSE(patchMeetsPlaneBetween(ramp, floor, onRamp, nodeAt(1.25, 0, 0.0), true, 0.02, 0.02));
+
+	// 3. A plate on the floor, 1.9 cm thick, rising at 6 deg from x = 1: z =
+	// 0.019 + 0.105104 (x - 1), d = 0.105104 - 0.019 = 0.086104. At the floor
+	// node q (1.0, 0, 0) it stands 1.9 cm above the floor: more than tol =
+	// 1.5 cm, but a lip no higher than the 2 cm traversable step: a
+	// junction. With a 3 cm lip (d = 0.075104), none.
+	const Plane plate{-0.105104, 0, 1, 0.086104}, thick{-0.105104, 0, 1, 0.075104};
+	const GroundNode foot = nodeAt(1.0, 0, 0.0);
+	EXPECT_NEAR(plate.heightAt(1.0, 0), 0.019, 1e-9);
+	EXPECT_TRUE(patchMeetsPlaneBetween(plate, floor, nodeAt(1.3, 0, plate.heightAt(1.3, 0)), foot, true, 0.015, 0.02));
+	EXPECT_FALSE(patchMeetsPlaneBetween(thick, floor, nodeAt(1.3, 0, thick.heightAt(1.3, 0)), foot, true, 0.015, 0.02));
+
+	// 4. The same 2 cm below the floor (a flat level at z = -0.02 next to a
+	// floor node): a step down, not a lip: no junction.
+	const Plane lower{0, 0, 1, 0.02};
+	EXPECT_FALSE(patchMeetsPlaneBetween(lower, floor, nodeAt(1.3, 0, -0.02), foot, true, 0.015, 0.02));
+
+	// 5. Between two patches (a landing and its ramp) the band at q stays
+	// 2 tol = 3 cm: 2.5 cm above the ramp's plane at q is a junction, 3.5 cm
+	// is not.
+	const Plane landing25{0, 0, 1, -0.025}, landing35{0, 0, 1, -0.035};
+	EXPECT_TRUE(patchMeetsPlaneBetween(landing25, floor, nodeAt(1.3, 0, 0.025), foot, false, 0.015, 0.02));
+	EXPECT_FALSE(patchMeetsPlaneBetween(landing35, floor, nodeAt(1.3, 0, 0.035), foot, false, 0.015, 0.02));
+}
