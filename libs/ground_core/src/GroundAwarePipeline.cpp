@@ -165,7 +165,6 @@ const FrameResult& GroundAwarePipeline::process(
 	hint.sensor_x = frame.sensor_position.x();
 	hint.sensor_y = frame.sensor_position.y();
 	if (std::isfinite(m_result.trust_range)) hint.fill_range = evidenceRange;
-	hint.traversable_step = m_params.ism.traversable_step;
 	m_rrt.detect(m_grid, hint, m_result.detection);
 	GroundDetection& det = m_result.detection;
 	if (m_params.max_ground_offset > 0 && m_params.rrt.variant != MethodVariant::Paper && det.ok() &&

@@ -1027,28 +1027,17 @@ void RrtGroundDetector::acceptPatch(const Plane& plane, size_t begin, size_t end
 	for (size_t a = begin; a < end; a++) out.nodes[m_patchNodes[a]].plane_id = id;
 }
 
-bool patchMeetsPlaneBetween(
-	const Plane& patch, const Plane& Q, const GroundNode& p, const GroundNode& q, bool qOnGroundPlane, double tol,
-	double traversableStep)
-{
-	// (Until 2026-11-27 the band at a ground node q was tol + the ground
-	// plane's RANSAC inlier distance, 2.5 cm, for the ramp's foot whose
-	// ground nodes lie on the ramp: q itself is the test for that now. The
-	// wider band let the lower level of a 5 cm step 4 m away join the floor:
-	// its nodes next to the edge, fitted over mixed cells, tilt its plane
-	// 2.3 deg toward the floor, 3-3.5 cm under the floor nodes there.)
-	const double lipAtQ = patch.heightAt(q.x, q.y) - Q.heightAt(q.x, q.y);
-	if (planesMeetBetween(patch, Q, p, q, tol, qOnGroundPlane ? tol : 2 * tol)) return true;
-	if (std::abs(patch.heightAt(q.x, q.y) - double(q.z)) <= tol) return true;
-	return qOnGroundPlane && lipAtQ > 0 && lipAtQ <= std::max(tol, traversableStep);
-}
-
 bool RrtGroundDetector::joinsAcceptedPlane(
 	const Plane& plane, size_t begin, size_t end, const GroundDetection& out, double tol) const
 {
 	// Between a patch node p and an accepted node q at most d_n apart (a tree
-	// step), the patch and q's plane Q meet as patchMeetsPlaneBetween() says.
-	// Two such pairs (one can be a node whose window straddles an edge).
+	// step), the patch and q's plane Q meet if the patch's height over Q
+	// changes sign from p to q, or is within the noise band `tol` at p, or
+	// at q within `tol` + the inlier distance of q's plane: q is that far
+	// off Q by definition (the foot of a ramp, up to 2.5 cm above the
+	// floor, holds ground-plane nodes that lie on the ramp). The lower level
+	// of a 5 cm step is further off. Two such pairs (one can be a node whose
+	// window straddles an edge).
 	const double link2 = m_params.expansion_distance * m_params.expansion_distance;
 	int joins = 0;
 	for (size_t a = begin; a < end; a++)
@@ -1060,8 +1049,8 @@ bool RrtGroundDetector::joinsAcceptedPlane(
 			const double dx = double(p.x) - q.x, dy = double(p.y) - q.y;
 			if (dx * dx + dy * dy > link2) continue;
 			const Plane& Q = out.planes[size_t(q.plane_id)];
-			if (patchMeetsPlaneBetween(plane, Q, p, q, q.plane_id == 0, tol, m_hint.traversable_step) && ++joins >= 2)
-				return true;
+			const double qBand = tol + (q.plane_id == 0 ? m_params.ransac_inlier_distance : tol);
+			if (planesMeetBetween(plane, Q, p, q, tol, qBand) && ++joins >= 2) return true;
 		}
 	}
 	return false;

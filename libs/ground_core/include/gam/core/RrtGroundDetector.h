@@ -205,9 +205,6 @@ struct GroundSeedHint
 	 * where the patches judge cells, not that of far floor). */
 	double fill_range = std::numeric_limits<double>::infinity();
 	double sensor_x = 0, sensor_y = 0;  ///< sensor position in the grid frame
-	/** The highest step a patch may meet the ground plane across (the map's
-	 * traversable_step): a ramp's lip no higher than that is still a way up. */
-	double traversable_step = 0.02;
 
 	bool withinFillRange(double px, double py) const
 	{
@@ -215,23 +212,6 @@ struct GroundSeedHint
 		return dx * dx + dy * dy <= fill_range * fill_range;
 	}
 };
-
-/** Whether an extra ground patch (plane `patch`, on node p) and an accepted
- * plane Q (on node q, at most a tree step from p) meet between p and q rather
- * than across a step (see RrtGroundDetector::fitPlanes):
- *  - the patch's height over Q changes sign from p to q (they cross), or
- *  - it is within `tol` (the patches' noise band) of Q at p or at q, or
- *  - the patch passes within `tol` of q itself (q lies on it: the foot of a
- *    ramp holds ground-plane nodes that are already on the ramp), or
- *  - Q is the ground plane and the patch stands above it at q by at most
- *    max(tol, traversableStep) (a ramp whose foot is a lip no higher than a
- *    traversable step is still a way up).
- * A patch that lies below the floor at q by more than `tol`, and below q
- * too, does not meet it: the lower level of a step down, fitted over the
- * edge's mixed cells as a ramp tilted toward the floor. */
-bool patchMeetsPlaneBetween(
-	const Plane& patch, const Plane& Q, const GroundNode& p, const GroundNode& q, bool qOnGroundPlane, double tol,
-	double traversableStep);
 
 /** The slope of a ground patch, measured twice: by the plane through its
  * nodes' centres (`nodesGradient`, dz/dx and dz/dy; the centres' residual
