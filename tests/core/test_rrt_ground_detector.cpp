@@ -337,6 +337,92 @@ TEST(RrtGroundDetector, RetriesFromFloorWhenSeededOnABoxTop)
 	for (const auto& n : out.nodes) EXPECT_NEAR(n.z, 0.0, 0.01);
 }
 
+TEST(RrtGroundDetector, ReseedsWhenTheSeedsPlaneHoldsTooFewOfTheTreesNodes)
+{
+	// Nothing seen within 0.6 m of the robot (the camera's blind zone); the
+	// nearest cells are the top of a 3.4 cm cable protector, 0.55 m deep and
+	// 0.6 m wide, lying across the view; the floor around and beyond it. The
+	// tree seeded on the protector steps down to the floor (3.4 cm < E_th =
+	// 5 cm) and covers it (about 260 nodes); the seed's own plane, the ground
+	// plane, holds the protector's top: a 0.55 x 0.6 m patch where nodes lie
+	// about d_n = 0.4 m apart, a handful of them (5 with this draw), fewer
+	// than min_nodes = 8.
+	ElevationGrid grid;
+	std::mt19937 rng(21);
+	gam::BinnedPoints b;
+	auto isProtector = [](double x, double y) { return gamtest::inRect(x, y, 0.6, 1.15, -0.3, 0.3); };
+	gamtest::sampleSurfaceIf(
+		grid, [&](double x, double y) { return gamtest::inRect(x, y, 0.6, 4, -2, 2) && !isProtector(x, y); },
+		[](double, double) { return 0.0; }, 3, 0.003, rng, b);
+	gamtest::sampleSurfaceIf(
+		grid, isProtector, [](double, double) { return 0.034; }, 3, 0.003, rng, b);
+	gamtest::insertAll(grid, b);
+	const GroundSeedHint hint{0, 0, 0};
+
+	RrtGpdParams p;
+	p.seed_attempts = 1;     // the first tree is kept, as before this rule
+	p.fill_patches = false;  // the tree's own nodes, which the rule counts
+	RrtGroundDetector one(p);
+	GroundDetection out;
+	one.detect(grid, hint, out);
+	ASSERT_EQ(out.status, Status::Ok) << out.describe();
+	EXPECT_NEAR(out.nodes.front().z, 0.034, 0.01);  // seeded on the protector
+	EXPECT_GT(out.nodes.size(), 100u);              // the tree is on the floor
+	EXPECT_LT(out.plane_support.front(), p.min_nodes);
+	EXPECT_NEAR(out.plane().heightAt(3, 0), 0.034, 0.01);  // the ground plane: the top
+
+	RrtGroundDetector reseed;  // default: 3 attempts, fill_patches
+	reseed.detect(grid, hint, out);
+	ASSERT_EQ(out.status, Status::Ok) << out.describe();
+	EXPECT_NEAR(out.nodes.front().z, 0.0, 0.01);  // seeded on the floor
+	EXPECT_GE(out.plane_support.front(), reseed.params().min_nodes);
+	EXPECT_NEAR(out.plane().heightAt(0, 0), 0.0, 0.005);
+	EXPECT_NEAR(out.plane().heightAt(3, 0), 0.0, 0.005);
+
+	// Were the robot's floor at the protector's height (hint 3.4 cm up), the
+	// floor tree's plane would pass 3.4 cm from it at the robot, the first
+	// tree's about 0: the first tree is grown again and kept.
+	const GroundSeedHint high{0, 0, 0.034};
+	reseed.detect(grid, high, out);
+	ASSERT_EQ(out.status, Status::Ok) << out.describe();
+	EXPECT_NEAR(out.nodes.front().z, 0.034, 0.01);
+	EXPECT_NEAR(out.plane().heightAt(0.9, 0), 0.034, 0.01);
+	EXPECT_LT(out.plane_support.front(), 30u);  // the top (and the fill's nodes on it), not the floor
+}
+
+TEST(RrtGroundDetector, PatchMeetsTheFloorBelowItOnlyWithinTheNoiseBandOrThroughTheNode)
+{
+	// Floor Q: z = 0. Patch node p at x = 1.0, floor node q at x = 0.7 (a
+	// tree step, d_n = 0.4 m). Noise band tol = 1 cm, the ground plane's
+	// inlier distance 2.5 cm: a patch parallel to the floor at height h
+	// meets it at q if |h| <= 1 cm, or 0 < h <= 1 + 2.5 = 3.5 cm.
+	const Plane floor;  // a = b = 0, c = 1, d = 0
+	GroundNode p, q;
+	p.x = 1.0f;
+	q.x = 0.7f;
+	const double tol = 0.01, inlier = 0.025;
+	auto level = [](double h) { return Plane::fromNormalAndPoint({0, 0, 1}, {0, 0, h}); };
+	auto meets = [&](const Plane& patch, bool qOnGround = true) {
+		return patchMeetsPlaneBetween(patch, floor, p, q, qOnGround, tol, inlier);
+	};
+	EXPECT_TRUE(meets(level(-0.009)));   // within the band
+	EXPECT_TRUE(meets(level(0.034)));    // a lip up: 3.4 <= 3.5 cm
+	EXPECT_FALSE(meets(level(0.036)));   // 3.6 > 3.5 cm
+	EXPECT_FALSE(meets(level(-0.034)));  // below: the lower level of a step (the old band took it)
+	// q itself on the patch (a ramp down whose top holds floor nodes 2.5 cm
+	// below the floor): |-0.030 - (-0.025)| = 0.5 cm <= tol.
+	q.z = -0.025f;
+	EXPECT_TRUE(meets(level(-0.030)));
+	q.z = 0;
+	// A patch crossing the floor between p and q: z = 0.1 (x - 0.85) is
+	// +1.5 cm at p and -1.5 cm at q.
+	EXPECT_TRUE(meets(Plane::fromNormalAndPoint({-0.1, 0, 1}, {0.85, 0, 0})));
+	// Q another patch: 2 tol at q, on either side; -1.9 cm meets, -2.1 does not.
+	EXPECT_TRUE(meets(level(-0.019), false));
+	EXPECT_FALSE(meets(level(-0.021), false));
+	EXPECT_FALSE(meets(level(0.021), false));
+}
+
 TEST(RrtGroundDetector, DeterministicForTheSameSeed)
 {
 	const ElevationGrid grid = floorWallBoxGrid();

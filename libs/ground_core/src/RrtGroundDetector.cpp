@@ -201,9 +201,39 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 	reserveScratch(g);
 
 	m_seedExcluded.clear();
+	// Excludes the cells within d_n of these nodes from the next seed search.
+	auto excludeAround = [&](auto&& take) {
+		if (m_seedExcluded.empty()) m_seedExcluded.assign(g.cellCount(), 0);
+		const int r = int(std::ceil(m_params.expansion_distance / g.resolution));
+		for (const GroundNode& n : out.nodes)
+		{
+			if (!take(n)) continue;
+			const int nx_ = g.ix(n.x), ny_ = g.iy(n.y);
+			for (int y = std::max(0, ny_ - r); y <= std::min(g.ny - 1, ny_ + r); y++)
+				for (int x = std::max(0, nx_ - r); x <= std::min(g.nx - 1, nx_ + r); x++)
+					m_seedExcluded[g.index(x, y)] = 1;
+		}
+	};
 	// The paper grows one tree from one seed, and RANSAC needs 3 nodes; the
-	// default re-seeds a tree that stayed below min_nodes (a box top).
+	// default re-seeds a tree that stayed below min_nodes (a box top), or
+	// whose ground plane (the seed's) holds fewer than min_nodes of its
+	// nodes: the tree may have started on a small flat patch and stepped
+	// down from it to the floor (a 3.4 cm cable protector across the bottom
+	// of an Astra's image: the ground plane was its top tilted down to the
+	// floor, 3 tree nodes, and the floor beyond an extra patch). A tree from
+	// another seed replaces that one only if its ground plane holds
+	// min_nodes and passes nearer the floor the robot stands on, at the
+	// robot: else the robot may stand at the foot of a ramp whose floor
+	// shows few nodes, and the first tree (that floor) is grown again.
 	const int attempts = paper() ? 1 : m_params.seed_attempts;
+	bool fitted = false;
+	bool haveFirst = false;  // a tree whose ground plane held too few nodes
+	GroundNode firstSeed;
+	double firstOffset = 0;
+	auto offsetAtRobot = [&]() {
+		return out.planes.empty() ? std::numeric_limits<double>::infinity()
+								  : std::abs(out.planes.front().heightAt(hint.x, hint.y) - hint.floor_z);
+	};
 	for (int attempt = 0; attempt < attempts; attempt++)
 	{
 		GroundNode seed;
@@ -216,22 +246,49 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 			}
 			break;
 		}
+		if (!haveFirst) m_rngAtFirst = m_rng;
 		if (m_params.variant == MethodVariant::Paper)
 			growTreePaper(grid, seed, out);
 		else
 			growTree(grid, seed, out);
-		if (out.nodes.size() >= minNodes()) break;
+		if (out.nodes.size() >= minNodes())
+		{
+			if (paper() || (!haveFirst && attempt + 1 == attempts)) break;
+			out.planes.clear();
+			out.plane_support.clear();
+			for (GroundNode& n : out.nodes) n.plane_id = -1;
+			fitPlanes(out);
+			fitted = true;
+			const bool enough = !out.planes.empty() && out.plane_support.front() >= minNodes();
+			if (enough && (!haveFirst || offsetAtRobot() < firstOffset))
+			{
+				haveFirst = false;  // this tree stays
+				break;
+			}
+			if (!haveFirst)
+			{
+				haveFirst = true;
+				firstSeed = seed;
+				firstOffset = offsetAtRobot();
+			}
+			// Exclude the seed's plane (or, without one, the seed) and try
+			// the next candidate.
+			const bool noPlane = out.planes.empty();
+			excludeAround([&](const GroundNode& n) { return noPlane ? &n == &out.nodes.front() : n.plane_id == 0; });
+			fitted = false;
+			continue;
+		}
 		// The seed was a small flat patch (a box top, a shelf board): exclude
 		// the area the tree covered and try the next candidate.
-		if (m_seedExcluded.empty()) m_seedExcluded.assign(g.cellCount(), 0);
-		const int r = int(std::ceil(m_params.expansion_distance / g.resolution));
-		for (const GroundNode& n : out.nodes)
-		{
-			const int nx_ = g.ix(n.x), ny_ = g.iy(n.y);
-			for (int y = std::max(0, ny_ - r); y <= std::min(g.ny - 1, ny_ + r); y++)
-				for (int x = std::max(0, nx_ - r); x <= std::min(g.nx - 1, nx_ + r); x++)
-					m_seedExcluded[g.index(x, y)] = 1;
-		}
+		excludeAround([](const GroundNode&) { return true; });
+	}
+	if (haveFirst)
+	{
+		// No other seed gave a better ground: the first tree, grown again
+		// from the same random state (the same tree).
+		m_rng = m_rngAtFirst;
+		growTree(grid, firstSeed, out);
+		fitted = false;
 	}
 
 	if (out.nodes.size() < minNodes())
@@ -239,7 +296,13 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 		out.status = GroundDetection::Status::TooFewNodes;
 		return;
 	}
-	fitPlanes(out);
+	if (!fitted)
+	{
+		out.planes.clear();
+		out.plane_support.clear();
+		for (GroundNode& n : out.nodes) n.plane_id = -1;
+		fitPlanes(out);
+	}
 	if (m_params.variant != MethodVariant::Paper && m_params.fill_patches && !out.planes.empty())
 	{
 		const Plane ground = out.planes.front();
@@ -1027,17 +1090,31 @@ void RrtGroundDetector::acceptPatch(const Plane& plane, size_t begin, size_t end
 	for (size_t a = begin; a < end; a++) out.nodes[m_patchNodes[a]].plane_id = id;
 }
 
+bool patchMeetsPlaneBetween(
+	const Plane& patch, const Plane& Q, const GroundNode& p, const GroundNode& q, bool qOnGroundPlane, double tol,
+	double groundInlierDistance)
+{
+	if (!qOnGroundPlane) return planesMeetBetween(patch, Q, p, q, tol, 2 * tol);
+	if (planesMeetBetween(patch, Q, p, q, tol, tol)) return true;
+	// q lies on the patch: the foot of a ramp up (or the top of a ramp down)
+	// holds ground-plane nodes that are already on it, up to the ground
+	// plane's inlier distance off the floor.
+	if (std::abs(patch.heightAt(q.x, q.y) - double(q.z)) <= tol) return true;
+	// Above the floor at q, the band of those nodes (until 2026-11-27 on
+	// both sides). Below it, not: the lower level of a 5 cm step, fitted
+	// over the edge's mixed cells as a plane tilted toward the floor, lay
+	// 3-3.5 cm under the floor at the floor nodes by the edge and joined
+	// within it, and its plane then freed the step (Kinect One, 4 m).
+	const double lipAtQ = patch.heightAt(q.x, q.y) - Q.heightAt(q.x, q.y);
+	return lipAtQ > 0 && lipAtQ <= tol + groundInlierDistance;
+}
+
 bool RrtGroundDetector::joinsAcceptedPlane(
 	const Plane& plane, size_t begin, size_t end, const GroundDetection& out, double tol) const
 {
 	// Between a patch node p and an accepted node q at most d_n apart (a tree
-	// step), the patch and q's plane Q meet if the patch's height over Q
-	// changes sign from p to q, or is within the noise band `tol` at p, or
-	// at q within `tol` + the inlier distance of q's plane: q is that far
-	// off Q by definition (the foot of a ramp, up to 2.5 cm above the
-	// floor, holds ground-plane nodes that lie on the ramp). The lower level
-	// of a 5 cm step is further off. Two such pairs (one can be a node whose
-	// window straddles an edge).
+	// step), the patch and q's plane Q meet as patchMeetsPlaneBetween() says.
+	// Two such pairs (one can be a node whose window straddles an edge).
 	const double link2 = m_params.expansion_distance * m_params.expansion_distance;
 	int joins = 0;
 	for (size_t a = begin; a < end; a++)
@@ -1049,8 +1126,9 @@ bool RrtGroundDetector::joinsAcceptedPlane(
 			const double dx = double(p.x) - q.x, dy = double(p.y) - q.y;
 			if (dx * dx + dy * dy > link2) continue;
 			const Plane& Q = out.planes[size_t(q.plane_id)];
-			const double qBand = tol + (q.plane_id == 0 ? m_params.ransac_inlier_distance : tol);
-			if (planesMeetBetween(plane, Q, p, q, tol, qBand) && ++joins >= 2) return true;
+			if (patchMeetsPlaneBetween(plane, Q, p, q, q.plane_id == 0, tol, m_params.ransac_inlier_distance) &&
+				++joins >= 2)
+				return true;
 		}
 	}
 	return false;

@@ -213,6 +213,21 @@ struct GroundSeedHint
 	}
 };
 
+/** Whether an extra ground patch (plane `patch`, on node p) and an accepted
+ * plane Q (on node q, at most a tree step from p) meet between p and q rather
+ * than across a step (see RrtGroundDetector::fitPlanes):
+ *  - the patch's height over Q changes sign from p to q (they cross), or
+ *  - it is within `tol` (the patches' noise band) of Q at p, or at q within
+ *    `tol` (2 `tol` where Q is another patch);
+ *  - where Q is the ground plane also: the patch passes within `tol` of q
+ *    itself (q lies on it), or stands above Q at q by at most `tol` +
+ *    `groundInlierDistance` (the ground plane's RANSAC inlier distance).
+ * A patch below the floor at q by more than `tol`, and below q too, does not
+ * meet it: the lower level of a step down. */
+bool patchMeetsPlaneBetween(
+	const Plane& patch, const Plane& Q, const GroundNode& p, const GroundNode& q, bool qOnGroundPlane, double tol,
+	double groundInlierDistance);
+
 /** The slope of a ground patch, measured twice: by the plane through its
  * nodes' centres (`nodesGradient`, dz/dx and dz/dy; the centres' residual
  * variance about it `residualVariance`, their 2D covariance `spread`) and by
@@ -367,6 +382,7 @@ class RrtGroundDetector
 
 	RrtGpdParams m_params;
 	std::mt19937 m_rng;
+	std::mt19937 m_rngAtFirst;  ///< m_rng before a tree that detect() may grow again
 	// Scratch, reused between frames (cleared, never shrunk): after the first
 	// frame of a given grid size and parameters, detect() allocates nothing.
 	std::vector<uint8_t> m_hasNode;
