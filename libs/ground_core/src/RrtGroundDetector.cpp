@@ -254,9 +254,6 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 		if (out.nodes.size() >= minNodes())
 		{
 			if (paper() || (!haveFirst && attempt + 1 == attempts)) break;
-			out.planes.clear();
-			out.plane_support.clear();
-			for (GroundNode& n : out.nodes) n.plane_id = -1;
 			fitPlanes(out);
 			fitted = true;
 			const bool enough = !out.planes.empty() && out.plane_support.front() >= minNodes();
@@ -296,13 +293,7 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 		out.status = GroundDetection::Status::TooFewNodes;
 		return;
 	}
-	if (!fitted)
-	{
-		out.planes.clear();
-		out.plane_support.clear();
-		for (GroundNode& n : out.nodes) n.plane_id = -1;
-		fitPlanes(out);
-	}
+	if (!fitted) fitPlanes(out);
 	if (m_params.variant != MethodVariant::Paper && m_params.fill_patches && !out.planes.empty())
 	{
 		const Plane ground = out.planes.front();
@@ -312,9 +303,6 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 		if (out.fill_nodes)
 		{
 			// Fit again with the filled patches (the ground plane holds the seed either way).
-			out.planes.clear();
-			out.plane_support.clear();
-			for (GroundNode& n : out.nodes) n.plane_id = -1;
 			fitPlanes(out);
 		}
 	}
@@ -825,7 +813,11 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 	// RANSAC over the node centres gives the ground plane; further RANSAC rounds
 	// over the remaining nodes give ramps and other ground patches that the tree
 	// reached through small elevation changes.
-	// (All vectors are members: see reserveScratch.)
+	// (All vectors are members: see reserveScratch.) Any planes of an earlier
+	// fit of these nodes (another tree, or before fill_patches) are dropped.
+	out.planes.clear();
+	out.plane_support.clear();
+	for (GroundNode& n : out.nodes) n.plane_id = -1;
 	std::vector<size_t>& remaining = m_remaining;
 	remaining.resize(out.nodes.size());
 	for (size_t i = 0; i < remaining.size(); i++) remaining[i] = i;

@@ -330,6 +330,7 @@ class RrtGroundDetector
 	void growTree(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
 	void growTreePaper(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
 	std::vector<std::pair<float, uint32_t>> m_candidates;  ///< paper fallback: (distance^2, node)
+	/** The planes of out.nodes, from scratch (earlier planes and node labels dropped). */
 	void fitPlanes(GroundDetection& out);
 	/** The ground plane grown from the seed's local plane (see fitPlanes);
 	 * false if it has fewer than rp.min_inliers nodes. Into m_ransac. */
