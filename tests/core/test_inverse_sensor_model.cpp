@@ -141,7 +141,6 @@ TEST(IsmParamsTest, ValidateAndDefaults)
 	EXPECT_THROW(bad([](IsmParams& p) { p.K_m = 1.0; }).validate(), std::invalid_argument);
 	EXPECT_THROW(bad([](IsmParams& p) { p.noise_sigmas = -1; }).validate(), std::invalid_argument);
 	EXPECT_THROW(bad([](IsmParams& p) { p.robot_height = 0; }).validate(), std::invalid_argument);
-	EXPECT_THROW(bad([](IsmParams& p) { p.max_drop_ray_length = -1; }).validate(), std::invalid_argument);
 
 	// Parameters are checked when they are set, not on every frame.
 	EXPECT_THROW(InverseSensorModel{bad([](IsmParams& p) { p.K_m = 2; })}, std::invalid_argument);
@@ -946,18 +945,27 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	EXPECT_EQ(ism.evidence()[g.index(g.ix(3.6), g.iy(0.0))], 0.5f);
 	checkEvidenceBookkeeping(ism);
 
-	// Limited ray length: only the 0.2 m before each voxel.
+	// A sensor far outside the grid, 100 m behind it, 1 m up (max range
+	// 200 m): each ray crosses the floor at x = -100 + (x + 100) / 1.3, about
+	// -21 m, and only its last part (at most the grid's diagonal) lies in the
+	// grid: the gap's cells (x 2.0-2.6, not seen) are under the rays, the
+	// upper floor keeps its free evidence (seen as ground), nothing is
+	// written outside the grid. (The fixed band d_pth: the range noise model
+	// at 100 m would take the lower floor for floor.)
+	IsmParams far = prm;
+	far.noise_sigmas = 0;
+	ism.setParams(far);
+	ism.compute(frame, handDetection(kFloor), {-100, 0, 1}, 200.0, st);
+	EXPECT_GT(st.drop_ray_cells, 0u);
+	EXPECT_NEAR(ism.evidence()[g.index(g.ix(2.05), g.iy(0.2))], pDrop, 1e-6);
+	EXPECT_NEAR(ism.evidence()[g.index(g.ix(2.55), g.iy(0.2))], pDrop, 1e-6);
+	EXPECT_FLOAT_EQ(ism.evidence()[g.index(g.ix(1.0), g.iy(0.2))], 0.2f);
+	checkEvidenceBookkeeping(ism);
+
 	IsmParams p;
 	p.min_obstacle_points = 1;
 	p.min_drop_points = 1;
 	p.drop_ray_min_points = 1;
-	p.max_drop_ray_length = 0.2;
-	ism.setParams(p);
-	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
-	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.15), g.iy(0.2))], 0.5f);
-	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.35), g.iy(0.2))], 0.5f);
-	EXPECT_NEAR(ism.evidence()[g.index(g.ix(2.55), g.iy(0.2))], pDrop, 1e-6);
-
 	// Disabled: the gap stays unknown, the drop voxels still count.
 	p.drop_rays = false;
 	ism.setParams(p);

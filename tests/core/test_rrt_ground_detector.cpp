@@ -77,7 +77,6 @@ TEST(RrtGpdParams, ValidateRejectsOutOfRangeValues)
 		 }},
 		{"d_n=0", [](RrtGpdParams& p) { p.expansion_distance = 0; }},
 		{"max_cell_std=0", [](RrtGpdParams& p) { p.max_cell_std = 0; }},
-		{"max_fit_rms<0", [](RrtGpdParams& p) { p.max_fit_rms = -1; }},
 		{"min_valid_cells=2", [](RrtGpdParams& p) { p.min_valid_cells = 2; }},
 		{"min_valid_cells>s_x*s_y", [](RrtGpdParams& p) { p.min_valid_cells = 10; }},
 		{"seed radius 0", [](RrtGpdParams& p) { p.seed_search_radius = 0; }},

@@ -774,6 +774,35 @@ void write2DScanRawlog(const std::string& path)
 }
 }  // namespace
 
+TEST(MapperCli, RetiredKeysAreIgnoredWithAWarning)
+{
+	// An .ini written for an older version sets keys of rules that were
+	// retired (doc/rules.md): it still runs, each such key named in a warning;
+	// a key that never existed is still an error (BadInputsGiveOneLineErrors).
+	fs::create_directories(kTmp);
+	const std::string rawlog = kTmp + "/lidar_only_retired.rawlog";
+	write2DScanRawlog(rawlog);
+	const std::string ini = kTmp + "/retired.ini";
+	std::ofstream(ini) << "[map]\n"
+						  "groundAwareGrid_count=1\n"
+						  "[map_groundAwareGrid_00_groundOpts]\n"
+						  "max_drop_ray_length=2.0\n"
+						  "missing_floor_min_range=0.5\n"
+						  "max_fit_rms=0.025\n";
+	const std::string out = freshDir("out_retired");
+	const auto r = runMapper("--rawlog '" + rawlog + "' --out '" + out + "' --config '" + ini + "' -q");
+	ASSERT_EQ(r.rc, 0) << r.err;
+	for (const char* key : {"max_drop_ray_length", "missing_floor_min_range", "max_fit_rms"})
+		EXPECT_NE(
+			r.err.find(
+				std::string("warning: [map_groundAwareGrid_00_groundOpts] key '") + key +
+				"' was retired and is ignored"),
+			std::string::npos)
+			<< key << "\n"
+			<< r.err;
+	EXPECT_TRUE(fs::exists(out + "/groundAwareGrid_00.pgm"));
+}
+
 TEST(MapperCli, MapsComeFromTheIniAlone)
 {
 	fs::create_directories(kTmp);

@@ -662,8 +662,10 @@ void InverseSensorModel::compute(
 	// Pass 2: the ray to a below-ground voxel crossed the ground plane and went
 	// on below it; no floor stopped it in between. Mark those cells, unless
 	// this frame saw ground there (a direct observation beats the inference).
-	// (A ray has at most max_drop_ray_length / (res / 2) steps: sized once.)
-	const size_t maxSteps = size_t(std::ceil(m_params.max_drop_ray_length / (0.5 * res))) + 1;
+	// A ray's part inside the grid is at most its diagonal long: steps of half
+	// a cell along it, sized once per grid.
+	const double diagonal = std::hypot(double(g.nx), double(g.ny)) * res;
+	const size_t maxSteps = size_t(std::ceil(diagonal / (0.5 * res))) + 1;
 	if (m_rayCells.size() < maxSteps) m_rayCells.resize(maxSteps);
 	for (uint32_t idx : m_dropVoxels)
 	{
@@ -690,14 +692,14 @@ void InverseSensorModel::compute(
 			stats.drop_rays_unsupported++;
 			continue;
 		}
-		if (len > m_params.max_drop_ray_length)
+		if (len > diagonal)
 		{
-			// Keep the part next to the voxel: far from it the plane estimate is
-			// extrapolated at a grazing angle.
-			const double s = m_params.max_drop_ray_length / len;
+			// The voxel is in the grid: farther from it than the grid's
+			// diagonal, the ray is outside it (a sensor outside the grid).
+			const double s = diagonal / len;
 			lx *= s;
 			ly *= s;
-			len = m_params.max_drop_ray_length;
+			len = diagonal;
 		}
 		const float p = m_evidence[idx];
 		const int steps = int(std::ceil(len / (0.5 * res)));

@@ -117,11 +117,10 @@ int emptyRow(const uint16_t* __restrict raw, int cols, uint16_t rawInRange, uint
 // statistics row of a depth image (a vector loop): which pixels are judged
 // (ok), and each one's depth t and frame cell. Float bounds stand
 // for judgeRay's double tests exactly: a float t <= maxRange (double) when t
-// <= the largest float not above it; t >= min_range when t >= the smallest
-// float not below it; int(cx) < nx when cx < nx.
+// <= the largest float not above it; int(cx) < nx when cx < nx.
 struct JudgeBounds
 {
-	float thrDown, maxRange, minRange, nx, ny;
+	float thrDown, maxRange, nx, ny;
 	int32_t cellsPerRow;
 };
 
@@ -136,7 +135,7 @@ void judgeableRow(
 		float tc, cx, cy;
 		g.meet(fy[c], fz[c], tc, cx, cy);
 		const bool judged = (g.n0 + g.n1 * fy[c] + g.n2 * fz[c] < b.thrDown) & (tc > 0.f) & (tc <= b.maxRange) &
-							(tc >= b.minRange) & (cx >= 0.f) & (cy >= 0.f) & (cx < b.nx) & (cy < b.ny);
+							(cx >= 0.f) & (cy >= 0.f) & (cx < b.nx) & (cy < b.ny);
 		// Zeros where not judged: no float-to-int conversion out of range.
 		const float x = judged ? cx : 0.f, y = judged ? cy : 0.f;
 		t[c] = tc;
@@ -164,7 +163,7 @@ void MissingFloorDetector::compute(
 		// a few frames -- one per camera -- still grew them now and then).
 		for (std::vector<uint32_t>* v : {&m_touched, &m_cells, &m_blocking, &m_queue, &m_region}) v->reserve(N);
 	}
-	if (!frame.has_image || classes.size() != N || !(maxRange > m_params.min_range)) return;
+	if (!frame.has_image || classes.size() != N || !(maxRange > 0)) return;
 	const RangeImageView& img = frame.image;
 	const PinholeIntrinsics& K = frame.intrinsics;
 	if (projector.rayTableSize() != size_t(K.width) * size_t(K.height) || img.rows != K.height || img.cols != K.width)
@@ -246,9 +245,6 @@ void MissingFloorDetector::compute(
 	bounds.thrDown = thrDown;
 	bounds.maxRange = float(maxRange);
 	if (double(bounds.maxRange) > maxRange) bounds.maxRange = std::nextafter(bounds.maxRange, 0.f);
-	bounds.minRange = float(m_params.min_range);
-	if (double(bounds.minRange) < m_params.min_range)
-		bounds.minRange = std::nextafter(bounds.minRange, std::numeric_limits<float>::infinity());
 	bounds.nx = float(g.nx);
 	bounds.ny = float(g.ny);
 	bounds.cellsPerRow = g.nx;
@@ -336,7 +332,7 @@ void MissingFloorDetector::compute(
 				const double fy = fyRow[c], fz = fzRow[c];
 				expected = t * std::sqrt(1.0 + fy * fy + fz * fz);
 			}
-			if (expected < m_params.min_range || expected > maxRange) return;
+			if (expected > maxRange) return;
 			if (!(cxf >= 0.f && cyf >= 0.f)) return;
 			const int cx = int(cxf), cy = int(cyf);
 			if (cx >= g.nx || cy >= g.ny) return;

@@ -59,10 +59,28 @@ class RecordingConfig : public mrpt::config::CConfigFileBase
 	mutable std::set<std::string> m_read;
 };
 
+/** Keys this project's maps once read and no longer do: a rule of the default
+ * that changed no map on any camera was retired with its key (issue #27,
+ * doc/rules.md). An .ini written for an older version still runs; the
+ * mapper says the key is ignored, and why. nullptr: not a retired key. */
+const char* retiredKeyReason(const std::string& key)
+{
+	static const std::pair<const char*, const char*> kRetired[] = {
+		{"max_drop_ray_length", "drop rays are no longer cut (the cut changed no map)"},
+		{"max_fit_rms", "a local fit is judged by its tilt (N_th) alone (the RMS limit changed no map)"},
+		{"missing_floor_min_range", "a missing-floor region needs seen floor nearer along its rays, which covers it"},
+	};
+	for (const auto& [k, why] : kRetired)
+		if (gam::iequals(key, k)) return why;
+	return nullptr;
+}
+
 /** Every sub-section `<prefix>_*` of a map must be one its class declares, with
- * keys it declares (an empty key list accepts any key). Throws ConfigError. */
+ * keys it declares (an empty key list accepts any key) or retired keys (a
+ * warning each). Throws ConfigError. */
 void checkSections(
-	const mrpt::config::CConfigFileBase& ini, const MapSpec& sp, const std::vector<gam::maps::IniSection>& declared)
+	const mrpt::config::CConfigFileBase& ini, const MapSpec& sp, const std::vector<gam::maps::IniSection>& declared,
+	std::vector<std::string>* warnings)
 {
 	std::vector<std::string> sections;
 	ini.getAllSections(sections);
@@ -82,6 +100,14 @@ void checkSections(
 		std::vector<std::string> secKeys;
 		ini.getAllKeys(sec, secKeys);
 		for (const auto& k : secKeys)
+		{
+			if (const char* why = retiredKeyReason(k))
+			{
+				if (warnings)
+					warnings->push_back(
+						"[" + sec + "] key '" + k + "' was retired and is ignored: " + why + " (doc/rules.md)");
+				continue;
+			}
 			if (std::none_of(
 					it->keys.begin(), it->keys.end(), [&](const std::string& a) { return gam::iequals(a, k); }))
 			{
@@ -90,6 +116,7 @@ void checkSections(
 				throw ConfigError(
 					"[" + sec + "] unknown key '" + k + "' (" + sp.className + " accepts: " + accepted + ")");
 			}
+		}
 	}
 }
 }  // namespace
@@ -148,7 +175,7 @@ void loadMapDefinitions(
 			// whose traits declare their sections).
 			const gam::maps::MapTraits* traits = gam::maps::findMapTraits(sp.className);
 			const bool ours = traits && !traits->sections.empty();
-			if (ours) checkSections(ini, sp, traits->sections);
+			if (ours) checkSections(ini, sp, traits->sections, warnings);
 
 			try
 			{
@@ -177,7 +204,7 @@ void loadMapDefinitions(
 					ini.getAllKeys(sec, secKeys);
 					for (const auto& k : secKeys)
 					{
-						if (ini.wasRead(sec, k)) continue;
+						if (ini.wasRead(sec, k) || (ours && retiredKeyReason(k))) continue;
 						const std::string msg = "[" + sec + "] key '" + k + "' is not used by " + sp.className;
 						if (ours) throw ConfigError(msg);
 						if (warnings) warnings->push_back(msg + " (typo?)");

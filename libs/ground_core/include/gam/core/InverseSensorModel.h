@@ -140,7 +140,6 @@ struct IsmParams
 	/** Below-ground voxels also mark the cells between the point where their
 	 * ray crossed the ground plane and the voxel: no floor was there. */
 	bool drop_rays = true;
-	double max_drop_ray_length = 2.0;  ///< [m]
 	/** A drop voxel casts its ray only with at least this many samples (below
 	 * the band, for a voxel judged by its bottom sample): one stray return (a
 	 * depth spike, a reflection metres below the floor) must not paint a line
@@ -215,7 +214,6 @@ struct IsmParams
 		visit(ParamInfo{"floor_noise_bin", 0.05, 10, "range bin of the measured floor noise [m]"}, p.floor_noise_bin);
 		visit(ParamInfo{"robot_height", 1e-3, 100, "voxels entirely above this do not block [m]"}, p.robot_height);
 		visit(ParamInfo{"drop_rays", 0, 1, "mark cells where rays went below the ground"}, p.drop_rays);
-		visit(ParamInfo{"max_drop_ray_length", 0, 100, "longest drop ray [m]"}, p.max_drop_ray_length);
 		visit(
 			ParamInfo{"drop_ray_min_points", 1, 1000000, "samples a drop voxel needs to cast its ray"},
 			p.drop_ray_min_points);

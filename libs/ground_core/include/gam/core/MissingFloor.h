@@ -38,9 +38,6 @@ namespace gam
 struct MissingFloorParams
 {
 	bool enabled = true;
-	/** Nearer than this the sensor returns nothing anyway (Kinect One:
-	 * 0.5 m): no floor is expected there. Depth along +X [m]. */
-	double min_range = 0.5;
 	/** A cell needs at least this many empty rays to be judged. */
 	int min_rays = 3;
 	/** Largest chance q^n that floor with the measured dropout rate q leaves a
@@ -67,9 +64,6 @@ struct MissingFloorParams
 		visit(
 			ParamInfo{"missing_floor", 0, 1, "mark floor that returned no depth where the ground predicts it"},
 			p.enabled);
-		visit(
-			ParamInfo{"missing_floor_min_range", 0, 100, "no floor return is expected nearer than this depth [m]"},
-			p.min_range);
 		visit(ParamInfo{"missing_floor_min_rays", 1, 65535, "empty rays a cell needs to be judged"}, p.min_rays);
 		visit(
 			ParamInfo{"missing_floor_alpha", 1e-300, 1, "max chance that dropping-out floor leaves a cell this empty"},

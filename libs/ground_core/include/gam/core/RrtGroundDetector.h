@@ -38,8 +38,6 @@ struct RrtGpdParams
 	/** Cells whose height spread (std) exceeds this are not surfaces (walls,
 	 * edges) and take no part in local fits. [m] */
 	double max_cell_std = 0.05;
-	/** Local fits with a larger RMS residual are not planar. [m] */
-	double max_fit_rms = 0.025;
 	/** A neighbourhood needs at least this many cells with a height. */
 	int min_valid_cells = 5;
 	/** The seed is the valid cell nearest to the robot within this radius [m]
@@ -66,7 +64,7 @@ struct RrtGpdParams
 	 * the tree climbed onto) or whose local plane leaves it by more than
 	 * ransac_inlier_distance within d_n (a ramp's foot), add nodes s_x by s_y
 	 * cells apart in the 8 directions, with the tree's own tests (E_th
-	 * against the parent's local plane, max_fit_rms, N_th), until the surface
+	 * against the parent's local plane, N_th), until the surface
 	 * meets the ground plane again or K nodes were added. The random
 	 * tree puts a node every ~d_n and reaches a narrow ramp only through its
 	 * foot: a 0.7 m wide 8 deg ramp got a handful of nodes near its foot in
@@ -93,7 +91,6 @@ struct RrtGpdParams
 		visit(ParamInfo{"s_y", 3, 31, "local fit neighbourhood along y [cells, odd]"}, p.neighbourhood_y);
 		visit(ParamInfo{"d_n", 1e-3, 100, "node expansion distance [m]"}, p.expansion_distance);
 		visit(ParamInfo{"max_cell_std", 1e-6, 10, "cells rougher than this are not surfaces [m]"}, p.max_cell_std);
-		visit(ParamInfo{"max_fit_rms", 1e-6, 10, "local fits with a larger RMS are not planar [m]"}, p.max_fit_rms);
 		visit(ParamInfo{"min_valid_cells", 3, 961, "cells with a height a local fit needs"}, p.min_valid_cells);
 		visit(
 			ParamInfo{"seed_search_radius", 1e-3, 1000, "seed within this distance of the robot [m]"},
@@ -308,11 +305,11 @@ class RrtGroundDetector
 
    private:
 	bool cellHeight(const ElevationGrid& grid, int cx, int cy, float& z) const;
-	/** A local fit the tree accepts: RMS within max_fit_rms, normal within N_th of vertical. */
-	bool planarEnough(const Plane& local, double rms) const;
+	/** A local fit the tree accepts: normal within N_th of vertical. */
+	bool planarEnough(const Plane& local) const;
 	/** rrt_variant = paper: Algorithm 1 and one RANSAC plane, without the
-	 * default's guards (max_cell_std, min_valid_cells, the seed's height and
-	 * RMS, re-seeding, min_nodes, RANSAC's tilt limit and refit, the
+	 * default's guards (max_cell_std, min_valid_cells, the seed's height,
+	 * re-seeding, min_nodes, RANSAC's tilt limit and refit, the
 	 * collinear-nodes rule). */
 	bool paper() const { return m_params.variant == MethodVariant::Paper; }
 	/** Nodes a tree needs: min_nodes, or the 3 of a plane in the paper's variant. */
