@@ -772,6 +772,19 @@ void write2DScanRawlog(const std::string& path)
 		ar << s;
 	}
 }
+
+/** The mapper on the 2D-scan rawlog with the .ini `iniText`, into a fresh
+ * `<name>` output folder (returned in `out`), quiet. */
+RunResult runLidarOnly(const std::string& name, const std::string& iniText, std::string& out)
+{
+	fs::create_directories(kTmp);
+	const std::string rawlog = kTmp + "/" + name + ".rawlog";
+	write2DScanRawlog(rawlog);
+	const std::string ini = kTmp + "/" + name + ".ini";
+	std::ofstream(ini) << iniText;
+	out = freshDir(name);
+	return runMapper("--rawlog '" + rawlog + "' --out '" + out + "' --config '" + ini + "' -q");
+}
 }  // namespace
 
 TEST(MapperCli, RetiredKeysAreIgnoredWithAWarning)
@@ -779,18 +792,16 @@ TEST(MapperCli, RetiredKeysAreIgnoredWithAWarning)
 	// An .ini written for an older version sets keys of rules that were
 	// retired (doc/rules.md): it still runs, each such key named in a warning;
 	// a key that never existed is still an error (BadInputsGiveOneLineErrors).
-	fs::create_directories(kTmp);
-	const std::string rawlog = kTmp + "/lidar_only_retired.rawlog";
-	write2DScanRawlog(rawlog);
-	const std::string ini = kTmp + "/retired.ini";
-	std::ofstream(ini) << "[map]\n"
-						  "groundAwareGrid_count=1\n"
-						  "[map_groundAwareGrid_00_groundOpts]\n"
-						  "max_drop_ray_length=2.0\n"
-						  "missing_floor_min_range=0.5\n"
-						  "max_fit_rms=0.025\n";
-	const std::string out = freshDir("out_retired");
-	const auto r = runMapper("--rawlog '" + rawlog + "' --out '" + out + "' --config '" + ini + "' -q");
+	std::string out;
+	const auto r = runLidarOnly(
+		"out_retired",
+		"[map]\n"
+		"groundAwareGrid_count=1\n"
+		"[map_groundAwareGrid_00_groundOpts]\n"
+		"max_drop_ray_length=2.0\n"
+		"missing_floor_min_range=0.5\n"
+		"max_fit_rms=0.025\n",
+		out);
 	ASSERT_EQ(r.rc, 0) << r.err;
 	for (const char* key : {"max_drop_ray_length", "missing_floor_min_range", "max_fit_rms"})
 		EXPECT_NE(
@@ -805,21 +816,19 @@ TEST(MapperCli, RetiredKeysAreIgnoredWithAWarning)
 
 TEST(MapperCli, MapsComeFromTheIniAlone)
 {
-	fs::create_directories(kTmp);
-	const std::string rawlog = kTmp + "/lidar_only.rawlog";
-	write2DScanRawlog(rawlog);
-	const std::string ini = kTmp + "/custom.ini";
-	std::ofstream(ini) << "[map]\n"
-						  "groundAwareGrid_count=1\n"
-						  "occupancyGrid_count=1\n"
-						  "pointsMap_count=1\n"
-						  "[map_occupancyGrid_00_creationOpts]\n"
-						  "label=stock\n"
-						  "min_x=-5\nmax_x=5\nmin_y=-5\nmax_y=5\nresolution=0.05\n"
-						  "[map_occupancyGrid_00_insertOpts]\n"
-						  "maxDistanceInsertoin=8\n";  // a typo: stock maps get a warning
-	const std::string out = freshDir("out_custom");
-	const auto r = runMapper("--rawlog '" + rawlog + "' --out '" + out + "' --config '" + ini + "' -q");
+	std::string out;
+	const auto r = runLidarOnly(
+		"out_custom",
+		"[map]\n"
+		"groundAwareGrid_count=1\n"
+		"occupancyGrid_count=1\n"
+		"pointsMap_count=1\n"
+		"[map_occupancyGrid_00_creationOpts]\n"
+		"label=stock\n"
+		"min_x=-5\nmax_x=5\nmin_y=-5\nmax_y=5\nresolution=0.05\n"
+		"[map_occupancyGrid_00_insertOpts]\n"
+		"maxDistanceInsertoin=8\n",  // a typo: stock maps get a warning
+		out);
 	ASSERT_EQ(r.rc, 0) << r.err;
 	EXPECT_NE(
 		r.err.find("ground-aware-mapper: warning: [map_occupancyGrid_00_insertOpts] key 'maxDistanceInsertoin'"),
