@@ -812,6 +812,18 @@ TEST(MapperCli, RetiredKeysAreIgnoredWithAWarning)
 			<< key << "\n"
 			<< r.err;
 	EXPECT_TRUE(fs::exists(out + "/groundAwareGrid_00.pgm"));
+
+	// Retired from the ground-aware section only: elsewhere the key is the
+	// error it always was (MRPT's stock sub-section never read it).
+	const auto elsewhere = runLidarOnly(
+		"out_retired_elsewhere",
+		"[map]\n"
+		"groundAwareGrid_count=1\n"
+		"[map_groundAwareGrid_00_insertOpts]\n"
+		"max_fit_rms=0.025\n",
+		out);
+	EXPECT_EQ(elsewhere.rc, 2) << elsewhere.err;
+	EXPECT_NE(elsewhere.err.find("key 'max_fit_rms' is not used by"), std::string::npos) << elsewhere.err;
 }
 
 TEST(MapperCli, MapsComeFromTheIniAlone)

@@ -59,19 +59,25 @@ class RecordingConfig : public mrpt::config::CConfigFileBase
 	mutable std::set<std::string> m_read;
 };
 
-/** Keys this project's maps once read and no longer do: a rule of the default
- * that changed no map on any camera was retired with its key (issue #27,
- * doc/rules.md). An .ini written for an older version still runs; the
- * mapper says the key is ignored, and why. nullptr: not a retired key. */
-const char* retiredKeyReason(const std::string& key)
+/** Keys this project's maps once read in the sub-section `suffix` (e.g.
+ * "_groundOpts") and no longer do: a rule of the default that changed no map
+ * on any camera was retired with its key (issue #27, doc/rules.md). An .ini
+ * written for an older version still runs; the mapper says the key is
+ * ignored, and why. nullptr: not a retired key of that sub-section. */
+const char* retiredKeyReason(const std::string& suffix, const std::string& key)
 {
-	static const std::pair<const char*, const char*> kRetired[] = {
-		{"max_drop_ray_length", "drop rays are no longer cut (the cut changed no map)"},
-		{"max_fit_rms", "a local fit is judged by its tilt (N_th) alone (the RMS limit changed no map)"},
-		{"missing_floor_min_range", "a missing-floor region needs seen floor nearer along its rays, which covers it"},
+	struct Retired
+	{
+		const char *suffix, *key, *why;
 	};
-	for (const auto& [k, why] : kRetired)
-		if (gam::iequals(key, k)) return why;
+	static const Retired kRetired[] = {
+		{"_groundOpts", "max_drop_ray_length", "drop rays are no longer cut (the cut changed no map)"},
+		{"_groundOpts", "max_fit_rms", "a local fit is judged by its tilt (N_th) alone (the RMS limit changed no map)"},
+		{"_groundOpts", "missing_floor_min_range",
+		 "a missing-floor region needs seen floor nearer along its rays, which covers it"},
+	};
+	for (const Retired& r : kRetired)
+		if (suffix == r.suffix && gam::iequals(key, r.key)) return r.why;
 	return nullptr;
 }
 
@@ -101,7 +107,7 @@ void checkSections(
 		ini.getAllKeys(sec, secKeys);
 		for (const auto& k : secKeys)
 		{
-			if (const char* why = retiredKeyReason(k))
+			if (const char* why = retiredKeyReason(suffix, k))
 			{
 				if (warnings)
 					warnings->push_back(
@@ -204,7 +210,8 @@ void loadMapDefinitions(
 					ini.getAllKeys(sec, secKeys);
 					for (const auto& k : secKeys)
 					{
-						if (ini.wasRead(sec, k) || (ours && retiredKeyReason(k))) continue;
+						if (ini.wasRead(sec, k) || (ours && retiredKeyReason(sec.substr(sp.prefix.size()), k)))
+							continue;
 						const std::string msg = "[" + sec + "] key '" + k + "' is not used by " + sp.className;
 						if (ours) throw ConfigError(msg);
 						if (warnings) warnings->push_back(msg + " (typo?)");
