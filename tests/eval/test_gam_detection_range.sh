@@ -11,8 +11,10 @@
 #   the limit is the range of trust the mapper prints (below 5 m at 0.8 m);
 # - approach mode, the 30 x 5 cm hole, one seed: a row whose ground_aware
 #   entry is a range within the 5.0 .. 1.0 m the approach covers;
-# - --help exits 0; a bad option, a missing build and --objects matching
-#   nothing exit 2 with one error line; --from re-reads detections.csv.
+# - --rrt-seed 7 (on the approach run): the mapper's config_used.ini has
+#   random_seed=7, the CSV names it;
+# - --help exits 0; a bad option, a missing build, --objects matching nothing
+#   and a bad --rrt-seed exit 2 with one error line; --from re-reads detections.csv.
 # usage: test_gam_detection_range.sh BUILD_DIR REPO
 set -euo pipefail
 build="$1" repo="$2"
@@ -57,9 +59,18 @@ awk -v t="$trust" -v l="$limit" 'BEGIN { exit !(t + 0 > 1.5 && t + 0 < 5.0 && l 
 	fail "d435: range of trust '$trust' not in (1.5, 5) m or not the limit ('$limit')"
 grep -qx "# camera: d435" "$w/d435.csv" || fail "d435 CSV names the camera"
 [[ "$(grep -c '^hole_0.30x0.05,hole,' "$w/d435.csv")" -eq 1 ]] || fail "d435 CSV: one map"
+grep -q "^# rrt_seed" "$w/d435.csv" && fail "no rrt_seed in the CSV without --rrt-seed"
 
+
+# (With --rrt-seed 7: the approach run keeps its maps, whose config_used.ini shows the seed the
+# mapper ran with.)
 "$tool" --build "$build" --modes approach --objects '^hole_0\.30x0\.05$' --seeds 1 --out "$w/appr" \
-	>"$w/appr.txt" 2>"$w/appr.err" || { cat "$w/appr.err"; fail "approach run failed"; }
+	--rrt-seed 7 --csv "$w/appr.csv" --commit smoke >"$w/appr.txt" 2>"$w/appr.err" ||
+	{ cat "$w/appr.err"; fail "approach run failed"; }
+used="$w/appr/approach/hole_0.30x0.05/s1/maps/config_used.ini"
+[[ -f "$used" ]] || fail "approach: no $used"
+grep -q '^random_seed=7\b' "$used" || fail "--rrt-seed 7: the mapper ran with $(grep '^random_seed=' "$used")"
+grep -qx "# rrt_seed: 7" "$w/appr.csv" || fail "--rrt-seed: the CSV names the seed"
 cat "$w/appr.txt"
 row="$(grep '^| hole_0.30x0.05 | 4.50 |' "$w/appr.txt")" || fail "approach row"
 ga="$(cut -d'|' -f6 <<<"$row" | xargs)"
@@ -105,4 +116,6 @@ set +e
 [[ $? -eq 2 ]] && grep -q "matches no object" "$w/err" || fail "--objects matching nothing"
 "$tool" --seeds 0 2>"$w/err"
 [[ $? -eq 2 ]] || fail "--seeds 0 accepted"
+"$tool" --rrt-seed x 2>"$w/err"
+[[ $? -eq 2 ]] && grep -q "rrt-seed takes a whole number" "$w/err" || fail "--rrt-seed x accepted"
 echo "PASS"
