@@ -61,7 +61,6 @@ grep -qx "# camera: d435" "$w/d435.csv" || fail "d435 CSV names the camera"
 [[ "$(grep -c '^hole_0.30x0.05,hole,' "$w/d435.csv")" -eq 1 ]] || fail "d435 CSV: one map"
 grep -q "^# rrt_seed" "$w/d435.csv" && fail "no rrt_seed in the CSV without --rrt-seed"
 
-
 # (With --rrt-seed 7: the approach run keeps its maps, whose config_used.ini shows the seed the
 # mapper ran with.)
 "$tool" --build "$build" --modes approach --objects '^hole_0\.30x0\.05$' --seeds 1 --out "$w/appr" \
