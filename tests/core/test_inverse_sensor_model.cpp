@@ -1532,6 +1532,57 @@ TEST(InverseSensorModel, AWallAtTheRangeLimitKeepsOnlyHalfItsSamples)
 	EXPECT_EQ(st.smeared, 1u);
 }
 
+TEST(InverseSensorModel, AWallBeyondTheRangeOfTrustStillExplainsItsSamplesInFront)
+{
+	// The frame of AWallsSamplesPushedTowardTheCamera... (wall W at x = 4.075,
+	// 300 samples 0.1-0.5 m; V at 4.025, 20 floor samples and 128 of the
+	// wall's heights; sigma 3 cm, sensor (0, 0, 0.5)), judged out to 4.05 m
+	// only (a camera's range of trust): V's centre lies hypot(4.025, 0.025) =
+	// 4.025078 m from the sensor, inside; W's hypot(4.075, 0.025) = 4.075077
+	// m, outside, so W is OutOfRange: seen, judged nowhere. Its samples still
+	// move by the camera's noise: lambda = 98.826 as there, bound 128.65,
+	// and 128 of them in V are W's.
+	EXPECT_NEAR(std::hypot(4.025, 0.025), 4.025078, 1e-6);
+	EXPECT_NEAR(std::hypot(4.075, 0.025), 4.075077, 1e-6);
+	IsmParams p;
+	ASSERT_TRUE(p.range_smear);
+	InverseSensorModel ism(p);
+	ism.setCameraNoise(flatNoise(0.03), 500);
+	IsmStats st;
+	BinnedPoints b;
+	const Eigen::Vector3d sensor{0, 0, 0.5};
+	const auto cellAt = [](const ElevationGrid& f, double x) {
+		return uint32_t(f.geometry().index(f.geometry().ix(x), f.geometry().iy(kSmearY)));
+	};
+	const double trusted = 4.05;
+	const ElevationGrid f128 = smearFrame(128, b);
+	ism.compute(f128, handDetection(kFloor), sensor, trusted, st, &b);
+	EXPECT_EQ(ism.classes()[cellAt(f128, kSmearW)], VoxelClass::OutOfRange);
+	EXPECT_EQ(ism.classes()[cellAt(f128, kSmearV)], VoxelClass::Obstacle);
+	EXPECT_EQ(ism.evidence()[cellAt(f128, kSmearV)], 0.5f) << "128 <= 128.65: the wall's samples";
+	EXPECT_EQ(ism.evidence()[cellAt(f128, kSmearW)], 0.5f) << "beyond the range: no evidence";
+	EXPECT_EQ(st.smeared, 1u);
+	const ElevationGrid f129 = smearFrame(129, b);
+	ism.compute(f129, handDetection(kFloor), sensor, trusted, st, &b);
+	EXPECT_GT(ism.evidence()[cellAt(f129, kSmearV)], 0.5f) << "129 > 128.65: more than the wall's noise explains";
+	EXPECT_EQ(st.smeared, 0u);
+	// The wall a cell farther (x = 4.125) with floor beyond the range between
+	// them (20 samples at z = 0 in the cell at 4.075: not as high as V's top,
+	// less the vertical share of 3 sigma, 0 on a level ray): V is an object
+	// of its own, as with that floor in range (AWallsSamplesPushed...'s
+	// `gap`). Without the floor, 8 in V are the wall's there (centres 0.1 m
+	// apart: lambda = 3.1, bound 8.4).
+	const ElevationGrid gap = smearFrame(8, b, 4.125, true);
+	ism.compute(gap, handDetection(kFloor), sensor, trusted, st, &b);
+	EXPECT_EQ(ism.classes()[cellAt(gap, 4.075)], VoxelClass::OutOfRange);
+	EXPECT_GT(ism.evidence()[cellAt(gap, kSmearV)], 0.5f) << "floor between: its own object";
+	EXPECT_EQ(st.smeared, 0u);
+	const ElevationGrid far = smearFrame(8, b, 4.125);
+	ism.compute(far, handDetection(kFloor), sensor, trusted, st, &b);
+	EXPECT_EQ(ism.evidence()[cellAt(far, kSmearV)], 0.5f) << "8 <= 8.4";
+	EXPECT_EQ(st.smeared, 1u);
+}
+
 TEST(InverseSensorModel, AStepDownsSamplesPushedAwayGiveNoDropBeyondItsEdge)
 {
 	// The mirror case: the face of a step down (a drop cell W at x = 4.025,

@@ -368,11 +368,21 @@ bool InverseSensorModel::smeared(
 			if (t > limit && !seenBefore) return true;
 			continue;
 		}
-		if (qc != same) return false;  // anything else between them: a separate object
+		// A cell beyond the range the map takes evidence from (max_range, or
+		// the camera's range of trust) was seen but judged nowhere: its
+		// samples moved as any others, and a wall that straddles that range
+		// puts its noise into the judged cells in front of it.
+		const bool unjudged = qc == VoxelClass::OutOfRange;
+		if (qc != same && !unjudged) return false;  // anything else between them: a separate object
 		const ElevationCell& w = frame.cell(q);
 		// As high (deep) as this cell's extreme sample, less the vertical share
-		// of the displacement.
-		if (drop ? w.z_min - rise > v.z_min : w.z_max + rise < v.z_max) continue;
+		// of the displacement. An unjudged cell that is not may be floor, which
+		// would make this cell an object of its own: kept.
+		if (drop ? w.z_min - rise > v.z_min : w.z_max + rise < v.z_max)
+		{
+			if (unjudged) return false;
+			continue;
+		}
 		const double d = std::hypot(g.cx(qx) - x, g.cy(qy) - y);
 		// The share of that cell's samples its noise leaves there, less those
 		// it moves past the limit; a cell wholly inside it is a surface seen

@@ -95,7 +95,9 @@ struct IsmParams
 	 * of its range plus half a cell (sigma from the camera's noise model, both
 	 * parts; horizontally sigma rho / r), a cell of the same class, with
 	 * nothing but unseen cells between them, reaches as high (deep), less the
-	 * vertical share of that move, and explains its samples beyond the band:
+	 * vertical share of that move (or a cell beyond the range the map judges,
+	 * max_range or the range of trust, reaches as high: seen, judged nowhere;
+	 * one that does not ends the walk), and explains its samples beyond the band:
 	 * they are no more than that cell's noise puts there (n_w * moved / stay,
 	 * plus noise_sigmas Poisson deviations; moved and stay from the normal
 	 * distribution of the move, cell centres d apart) and nearer that count
