@@ -1299,6 +1299,11 @@ ElevationGrid smearFrame(int inFront, BinnedPoints& b, double wallX = kSmearW, b
 	grid.insert(b, OutlierFilterParams{});
 	return grid;
 }
+// The cell of a smearFrame() at x on its row.
+uint32_t cellAt(const ElevationGrid& f, double x)
+{
+	return uint32_t(f.geometry().index(f.geometry().ix(x), f.geometry().iy(kSmearY)));
+}
 CameraNoise flatNoise(double sigma)
 {
 	CameraNoise n;
@@ -1321,9 +1326,6 @@ TEST(InverseSensorModel, AWallsSamplesPushedTowardTheCameraGiveNoObstacleInFront
 	IsmStats st;
 	BinnedPoints b;
 	const Eigen::Vector3d sensor{0, 0, 0.5};
-	const auto cellAt = [](const ElevationGrid& f, double x) {
-		return uint32_t(f.geometry().index(f.geometry().ix(x), f.geometry().iy(kSmearY)));
-	};
 	const ElevationGrid f128 = smearFrame(128, b);
 	ism.compute(f128, handDetection(kFloor), sensor, 5.0, st, &b);
 	EXPECT_EQ(ism.classes()[cellAt(f128, kSmearV)], VoxelClass::Obstacle);
@@ -1551,9 +1553,6 @@ TEST(InverseSensorModel, AWallBeyondTheRangeOfTrustStillExplainsItsSamplesInFron
 	IsmStats st;
 	BinnedPoints b;
 	const Eigen::Vector3d sensor{0, 0, 0.5};
-	const auto cellAt = [](const ElevationGrid& f, double x) {
-		return uint32_t(f.geometry().index(f.geometry().ix(x), f.geometry().iy(kSmearY)));
-	};
 	const double trusted = 4.05;
 	const ElevationGrid f128 = smearFrame(128, b);
 	ism.compute(f128, handDetection(kFloor), sensor, trusted, st, &b);
