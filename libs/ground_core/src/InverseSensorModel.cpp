@@ -392,6 +392,8 @@ bool InverseSensorModel::smeared(
 		const double stayHere = room >= 0.5 * res ? stay : phi(room / sigma2d) - phi(-0.5 * res / sigma2d);
 		seenBefore |= room >= 0.5 * res;
 		if (!(stayHere > 0)) continue;
+		// (An unjudged cell has no band to count beyond: all its samples, of
+		// which a wall's lowest few centimetres are a few per cent.)
 		const uint32_t wBeyond = m_tailCell[q] ? m_tailCount[q] : w.count;
 		// This cell's samples are that cell's if they are no more than its
 		// noise puts here (expected lambda, and noise_sigmas Poisson
