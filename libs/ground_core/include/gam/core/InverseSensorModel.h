@@ -189,7 +189,8 @@ struct IsmParams
 			ParamInfo{
 				"range_smear", 0, 1,
 				"an obstacle (drop) cell whose samples beyond the band are what the range noise of a cell of the "
-				"same class behind (before) it along its ray moves there gives no evidence"},
+				"same class behind (before) it along its ray, or of one as high beyond the judged range, moves there "
+				"gives no evidence"},
 			p.range_smear);
 		visit(
 			ParamInfo{"traversable_step", 0, 1, "bumps and dips smaller than this are floor for the robot [m]"},
