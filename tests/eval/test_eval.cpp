@@ -24,6 +24,7 @@ namespace
 //   'A' obstacle of object 1 (small)   'B' drop of object 2 (negative)
 //   'C' obstacle of object 3 (large)   'D' obstacle of object 4 (overhang)
 //   'E' unobserved obstacle of object 6 (large, never seen: must not count)
+//   'q' unobserved cell of the ramp (object 5)
 const std::vector<std::string> kScene = {
 	"??????????????",  //
 	"?...........E?",  //
@@ -70,9 +71,9 @@ std::string writeGt(const TempDir& d, const std::vector<std::string>& rows = kSc
 	std::ostringstream l;
 	l << "ix,iy,x,y,label,object_id,category\n";
 	const int ny = int(rows.size()), nx = int(rows[0].size());
-	const std::map<char, std::pair<int, std::string>> obj = {{'A', {1, "small"}}, {'B', {2, "negative"}},
-															 {'C', {3, "large"}}, {'D', {4, "overhang"}},
-															 {'r', {5, "ramp"}},  {'E', {6, "large"}}};
+	const std::map<char, std::pair<int, std::string>> obj = {
+		{'A', {1, "small"}}, {'B', {2, "negative"}}, {'C', {3, "large"}}, {'D', {4, "overhang"}},
+		{'r', {5, "ramp"}},  {'E', {6, "large"}},    {'q', {5, "ramp"}}};
 	for (int iy = 0; iy < ny; iy++)
 		for (int ix = 0; ix < nx; ix++)
 		{
@@ -80,7 +81,7 @@ std::string writeGt(const TempDir& d, const std::vector<std::string>& rows = kSc
 			std::string label = "free";
 			int id = 0;
 			std::string cat = "none";
-			if (c == '?' || c == 'E')
+			if (c == '?' || c == 'E' || c == 'q')
 				label = "unobserved";
 			else if (c == 'B')
 				label = "drop";
@@ -122,7 +123,8 @@ std::vector<std::vector<uint8_t>> perfectPixels(const std::vector<std::string>& 
 	{
 		std::vector<uint8_t> line;
 		for (char c : r)
-			for (int s = 0; s < sub; s++) line.push_back(c == '?' || c == 'E' ? 128 : (c == '.' || c == 'r') ? 255 : 0);
+			for (int s = 0; s < sub; s++)
+				line.push_back(c == '?' || c == 'E' || c == 'q' ? 128 : (c == '.' || c == 'r') ? 255 : 0);
 		for (int s = 0; s < sub; s++) px.push_back(line);
 	}
 	return px;
@@ -224,6 +226,42 @@ TEST(Eval, MissingObjectFalseObstacleAndUnknownCells)
 	EXPECT_EQ(s0.main.floor.occupied, 2);
 	EXPECT_EQ(s0.excluded_floor, 0);
 	EXPECT_EQ(s0.main.floor.n, 12 * 8 - 15);
+}
+
+TEST(Eval, FloorNextToAnUnobservedObstacleCellIsNotScored)
+{
+	// A wall whose face lies in the outer sixth of the floor cell in front of
+	// it: the GT's probes miss it there (that cell is floor), and every ray
+	// ends in that cell, so the wall's own cells stay unobserved ('E'). A map
+	// that marks the cell holding the face is right; the tolerance band holds
+	// it as it holds the cells next to a wall that was observed. A ramp's
+	// unobserved cell ('q') may be floor or a side face: no band around it.
+	const std::vector<std::string> rows = {
+		"???????",  //
+		"?....E?",  //
+		"?.....?",  //
+		"?....q?",  //
+		"???????",
+	};
+	TempDir d;
+	const GroundTruth gt = loadGroundTruth(writeGt(d, rows));
+	auto px = perfectPixels(rows);
+	at(px, 4, 3) = 0;  // in front of E (row 1 -> iy 3)
+	at(px, 4, 1) = 0;  // in front of q (row 3 -> iy 1)
+	const MapScore s = evaluate(gt, loadRosMap(writeMap(d, "m", px, kRes, 0, 0)));
+	// 13 observed free cells (rows 1-3, columns 1-5, but E and q); within one
+	// cell of E: (4, 3), (4, 2), (5, 2).
+	EXPECT_EQ(s.excluded_floor, 3);
+	EXPECT_EQ(s.main.floor.n, 13 - 3);
+	EXPECT_EQ(s.main.floor.occupied, 1);  // the cell next to q
+	// E is no object of the score: none of its cells was observed.
+	EXPECT_TRUE(s.main.objects.empty());
+	Options o0;
+	o0.tolerance_cells = 0;
+	const MapScore s0 = evaluate(gt, loadRosMap(writeMap(d, "m0", px, kRes, 0, 0)), o0);
+	EXPECT_EQ(s0.excluded_floor, 0);
+	EXPECT_EQ(s0.main.floor.n, 13);
+	EXPECT_EQ(s0.main.floor.occupied, 2);
 }
 
 TEST(Eval, MinHitsAndCoverage)

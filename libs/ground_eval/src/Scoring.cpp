@@ -96,6 +96,34 @@ void count(CellCounts& c, CellState s)
 
 bool isObstacle(Label l) { return l == Label::Obstacle || l == Label::Drop; }
 
+// The cells the floor's tolerance band is measured from: every GT obstacle or
+// drop cell, observed or not. A cell of an obstacle, hole or overhang that no
+// noise-free ray reached is still there: a wall whose face lies in the outer
+// sixth of the floor cell in front of it (beyond that cell's outermost probe)
+// leaves that cell free and takes every ray's end, so the wall's own cells
+// stay unobserved, and the floor cell that holds its face was scored as
+// floor. The GT file gives an unobserved cell's object but not its label: a
+// cell of an object that is not a ramp is one of its obstacle or drop cells
+// (the simulator gives a free cell no object but a ramp's); a ramp's
+// unobserved cells may be either and are left out.
+std::vector<uint8_t> objectCells(const GroundTruth& gt)
+{
+	std::vector<uint8_t> solid(gt.label.size(), 0);
+	std::map<int, bool> notRamp;
+	for (const GtObject& o : gt.objects) notRamp[o.id] = o.category != "ramp";
+	for (size_t i = 0; i < solid.size(); i++)
+	{
+		if (isObstacle(gt.label[i]))
+			solid[i] = 1;
+		else if (gt.label[i] == Label::Unobserved && gt.objectId[i] != 0)
+		{
+			const auto it = notRamp.find(gt.objectId[i]);
+			solid[i] = it != notRamp.end() && it->second;
+		}
+	}
+	return solid;
+}
+
 Reading score(
 	const GroundTruth& gt, const std::vector<CellState>& st, const std::vector<uint8_t>& floorMask, const Options& opt)
 {
@@ -151,6 +179,7 @@ MapScore evaluate(const GroundTruth& gt, const RosMap& map, const Options& opt)
 	ms.yamlPath = map.yamlPath;
 	// floor mask: observed free cells farther than tolerance_cells from obstacle/drop cells
 	const int t = std::max(0, opt.tolerance_cells);
+	const std::vector<uint8_t> solid = objectCells(gt);
 	std::vector<uint8_t> floorMask(gt.label.size(), 0);
 	for (int iy = 0; iy < gt.ny; iy++)
 		for (int ix = 0; ix < gt.nx; ix++)
@@ -163,7 +192,7 @@ MapScore evaluate(const GroundTruth& gt, const RosMap& map, const Options& opt)
 				{
 					const int x = ix + dx, y = iy + dy;
 					if (x < 0 || y < 0 || x >= gt.nx || y >= gt.ny) continue;
-					near = isObstacle(gt.label[gt.idx(x, y)]);
+					near = solid[gt.idx(x, y)] != 0;
 				}
 			if (near)
 				ms.excluded_floor++;

@@ -17,7 +17,9 @@
 //    least `min_hits` of them are occupied in the map. Its coverage = occupied /
 //    observed cells.
 //  * Floor = observed GT cells labelled free (plain floor, ramps, mats) farther than
-//    `tolerance_cells` (Chebyshev) from any GT obstacle/drop cell.
+//    `tolerance_cells` (Chebyshev) from any GT obstacle/drop cell, observed or not (an
+//    unobserved cell of an object that is not a ramp counts as one of its obstacle or
+//    drop cells: the GT file does not give an unobserved cell's label).
 #pragma once
 
 #include <cstdint>
@@ -40,8 +42,8 @@ struct Options
 {
 	/** unknown band around p = 0.5 for the main reading (one grey level each side). */
 	double unknown_tolerance = 1.0 / 255.0;
-	/** floor cells closer than this (Chebyshev, cells) to a GT obstacle/drop cell are
-	 * not scored. */
+	/** floor cells closer than this (Chebyshev, cells) to a GT obstacle/drop cell,
+	 * observed or not, are not scored. */
 	int tolerance_cells = 1;
 	/** occupied observed cells an object needs to count as detected. */
 	int min_hits = 1;
