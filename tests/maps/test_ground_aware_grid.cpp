@@ -550,6 +550,68 @@ TEST(GroundAwareGrid, LeddarScansTakeBackOnlyTheirOwnHits)
 	EXPECT_FLOAT_EQ(g.getCell(unsigned(ux), unsigned(uy)), marked) << "not a scan's hit: kept";
 }
 
+TEST(GroundAwareGrid, AnEchoInACellScansHaveSeenThroughIsTakenForNoise)
+{
+	// A scan's evidence in a cell is kept net: the cell holds what else was
+	// said there plus min(0, the scans' echoes net of the rays passing since),
+	// and an echo in a cell that scans have seen through since its last echo
+	// adds nothing (the range noise of the surface behind it). MRPT's own beam
+	// model on a stock grid gives each scan's log-odds step (the oracle).
+	// 65 beams 0.025 rad apart from (0, 0.025): only the middle one (angle 0)
+	// crosses the cell [2.00, 2.05) x [0, 0.05); its neighbours are at y =
+	// 0.025 +- 2 tan 0.025 = 0.075 / -0.025 there.
+	auto fan = [](float range) {
+		auto s = planarScan(mrpt::RAD2DEG(64 * 0.025), 65, CPose3D(0, 0.025, 0.3, 0, 0, 0));
+		for (size_t i = 0; i < 65; i++) s.setScanRange(i, range);
+		return s;
+	};
+	const float x = 2.025f, y = 0.025f;
+	const auto cellOf = [&](const COccupancyGridMap2D& m) {
+		return int(m.getRawMap()[size_t(m.x2idx(x)) + size_t(m.y2idx(y)) * m.getSizeX()]);
+	};
+	// The oracle: one echo, one pass.
+	COccupancyGridMap2D stock(-5, 5, -5, 5, 0.05f);
+	stock.insertObservation(fan(2.025f));
+	const int echo = cellOf(stock);
+	stock.insertObservation(fan(4.0f));
+	const int pass = cellOf(stock) - echo;
+	ASSERT_LT(echo, -2 * pass);
+	ASSERT_GT(pass, 0);
+	{
+		CGroundAwareOccupancyGrid g(-5, 5, -5, 5, 0.05f);
+		setScanRule(g, ScanRule::KeepCameraFloor);
+		ASSERT_TRUE(g.insertObservation(fan(4.0f)));
+		EXPECT_EQ(cellOf(g), 0) << "seen through: never freer than unknown";
+		g.insertObservation(fan(2.025f));
+		EXPECT_EQ(cellOf(g), 0) << "an echo in a cell seen through since: no evidence";
+		g.insertObservation(fan(2.025f));
+		EXPECT_EQ(cellOf(g), echo) << "the second echo counts in full";
+		EXPECT_GT(pOcc(g, x, y), 0.5);
+		g.insertObservation(fan(4.0f));
+		EXPECT_EQ(cellOf(g), echo + pass) << "a pass takes back part of it";
+		for (int k = 0; k < 20; k++) g.insertObservation(fan(4.0f));
+		EXPECT_EQ(cellOf(g), 0) << "all of it, up to unknown";
+		g.insertObservation(fan(2.025f));
+		EXPECT_EQ(cellOf(g), 0) << "and the next short echo is noise again";
+	}
+	{
+		// Floor the camera saw free (here set by hand: base 45, p_free 0.95):
+		// a scan's echo there counts, later passes take it back exactly to the
+		// base, and none makes the cell freer.
+		CGroundAwareOccupancyGrid g(-5, 5, -5, 5, 0.05f);
+		setScanRule(g, ScanRule::KeepCameraFloor);
+		g.setCell(unsigned(g.x2idx(x)), unsigned(g.y2idx(y)), 0.95f);
+		const int base = cellOf(g);
+		ASSERT_GT(base + echo, int(COccupancyGridMap2D::OCCGRID_CELLTYPE_MIN));
+		g.insertObservation(fan(2.025f));
+		EXPECT_EQ(cellOf(g), base + echo);
+		g.insertObservation(fan(4.0f));
+		EXPECT_EQ(cellOf(g), base + echo + pass);
+		for (int k = 0; k < 20; k++) g.insertObservation(fan(4.0f));
+		EXPECT_EQ(cellOf(g), base) << "back to what the camera said, not freer";
+	}
+}
+
 TEST(GroundAwareGrid, MalformedObservationsThrowClearErrors)
 {
 	auto obs = testscene::renderDepth(holeAndBoxScene(), kKinect);

@@ -465,11 +465,21 @@ bool CGroundAwareOccupancyGrid::insert2D(
 	// drove cells seen as floor from afar -- where a pit's visible part is
 	// shallower than the ground band -- to the log-odds clamp, and the drop
 	// seen later from close by could no longer mark them: issue #17.)
-	// One exception: a cell that only scans made occupied may be taken back
-	// by a later scan, up to unknown. A wide beam's echo is the nearest return
-	// in its cone and is drawn across the whole cone, up to 10 cm in front of
-	// a wall seen at an angle from 5 m; the beams that later pass through
-	// those cells undo that, and nothing the camera saw is touched.
+	// One exception: what scans marked, scans may take back. Each cell keeps
+	// the scans' own evidence there, their ledger S (m_scanOnlyLayer): the sum
+	// of what MRPT's beam model added, hits (< 0) and rays passing (> 0). The
+	// cell holds what the camera (or a loaded map) said, its base, plus the
+	// scans' net hits: base + min(0, S), never freer than the base. A wide
+	// beam's echo is the nearest return in its cone and is drawn across the
+	// whole cone, up to 10 cm in front of a wall seen at an angle from 5 m;
+	// the beams that later pass through those cells undo that. And an echo
+	// in a cell that scans have seen through since its last echo is taken
+	// for the range noise of the surface behind it and adds nothing (a
+	// Leddar's 2.5 cm puts 2 % of a far wall's echoes 5 cm or more short, and
+	// with a D400 nothing else judges the floor there): a new obstacle in such
+	// a cell is marked by its second echo. (It used to keep only a mark
+	// "scans made it occupied" and take such a cell back up to unknown: the
+	// passes beyond that were lost, and the next short echo marked it again.)
 	const std::vector<cellType> before = m_map;
 	const double scanTime = rawScan.timestamp == INVALID_TIMESTAMP ? 0.0 : mrpt::Clock::toDouble(rawScan.timestamp);
 	const float x0 = getXMin(), y0 = getYMin();
@@ -480,8 +490,7 @@ bool CGroundAwareOccupancyGrid::insert2D(
 	const int ox = int(std::lround((x0 - getXMin()) / getResolution()));
 	const int oy = int(std::lround((y0 - getYMin()) / getResolution()));
 	syncLayer(m_scanOnlyLayer);
-	cellType* scanOnly = m_scanOnlyLayer.getRow(0);
-	const cellType kScanOnly = std::numeric_limits<cellType>::min();
+	cellType* ledger = m_scanOnlyLayer.getRow(0);
 	// Every cell of the grid as it is now: a cell the scan grew the grid by was
 	// unknown before it (a scan that grew the grid used to free those cells).
 	for (int ny = 0; ny < sy; ny++)
@@ -492,10 +501,13 @@ bool CGroundAwareOccupancyGrid::insert2D(
 			const cellType old = wasThere ? before[size_t(cy) * size_t(sx0) + size_t(cx)] : cellType(0);
 			const size_t i = size_t(ny) * size_t(sx) + size_t(nx);
 			cellType& now = m_map[i];
-			if (now > old)
-				now = scanOnly[i] == kScanOnly ? std::max(old, std::min<cellType>(now, 0)) : old;
-			else if (now < old && old >= 0)
-				scanOnly[i] = kScanOnly;  // this scan made it occupied
+			if (now == old) continue;
+			// A ledger > 0 (1) says "seen through since its last echo".
+			const int s0 = ledger[i], d = int(now) - int(old);
+			const int s1 = d < 0 && s0 > 0 ? 0 : std::clamp(s0 + d, int(OCCGRID_CELLTYPE_MIN), 1);
+			ledger[i] = cellType(s1);
+			now = cellType(std::clamp(
+				int(old) - std::min(0, s0) + std::min(0, s1), int(OCCGRID_CELLTYPE_MIN), int(OCCGRID_CELLTYPE_MAX)));
 			if (m_options.obstacle_decay_s > 0 && now < old) notePositive(nx, ny, scanTime);
 		}
 	if (m_options.obstacle_decay_s > 0 && scanTime > 0) decayObstacles(scanTime);
@@ -862,15 +874,16 @@ void CGroundAwareOccupancyGrid::applyEvidence(const gam::GroundAwarePipeline& pi
 	const float pMissing = float(0.5 + 0.5 * m_options.pipeline.ism.K_m);
 	const int sx = int(getSizeX()), sy = int(getSizeY());
 	syncLayer(m_scanOnlyLayer);
-	cellType* scanOnly = m_scanOnlyLayer.getRow(0);
+	cellType* scanLedger = m_scanOnlyLayer.getRow(0);
 	const auto update = [&](uint32_t c, float pOcc) {
 		const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
 		const int wx = x2idx(g.cx(cx)), wy = y2idx(g.cy(cy));
 		if (wx < 0 || wy < 0 || wx >= sx || wy >= sy) return;
 		const float pFree = std::clamp(1.0f - pOcc, gam::ism::kEvidenceFloor, 1.0f - gam::ism::kEvidenceFloor);
 		const int l = int(p2l(pFree));
-		// What the camera marks, no 2D scan takes back.
-		if (pOcc > 0.5f) scanOnly[size_t(wx) + size_t(wy) * getSizeX()] = 0;
+		// What the camera marks, no 2D scan takes back: the scans' hits there
+		// become part of the cell's base (their ledger starts again at 0).
+		if (pOcc > 0.5f) scanLedger[size_t(wx) + size_t(wy) * getSizeX()] = 0;
 		cellType& cell = m_map[size_t(wx) + size_t(wy) * getSizeX()];
 		cell = cellType(std::clamp(int(cell) + l, int(OCCGRID_CELLTYPE_MIN), int(OCCGRID_CELLTYPE_MAX)));
 	};

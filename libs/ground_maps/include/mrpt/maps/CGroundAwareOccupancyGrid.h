@@ -128,8 +128,8 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 			visit(
 				gam::ParamInfo{
 					"scan_keeps_3d_obstacles", 0, 2,
-					"2D scans add their hits and free no cell: true | false (MRPT's beam model) | auto (false until "
-					"the first depth frame)",
+					"2D scans add their hits and free no cell (they take back their own hits): true | false (MRPT's "
+					"beam model) | auto (false until the first depth frame)",
 					kScanRuleNames},
 				o.scan_keeps_3d_obstacles);
 			visit(
@@ -354,9 +354,11 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	std::string m_lastSensorLabel;
 	std::map<std::string, TCameraInfo> m_cameras;  // not serialized: state of a run
 	mutable COccupancyGridMap2D m_missingLayer;
-	// Cells that only 2D scans made occupied (lowest cell value; anything else
-	// = the camera's or unknown provenance, which scans never free). State of
-	// a run: not serialized, so a loaded map's obstacles all stay.
+	// The 2D scans' own evidence per cell, their ledger (log-odds as MRPT's
+	// cells: their hits net of the rays passing since, <= 0; 1 where rays
+	// have passed since the last echo; 0 where the camera marked an obstacle
+	// since): the cell holds the rest plus min(0, ledger), see insert2D().
+	// State of a run: not serialized, so a loaded map's obstacles all stay.
 	COccupancyGridMap2D m_scanOnlyLayer;
 	// obstacle_decay_s: last time each positive obstacle cell was seen as one,
 	// keyed by its world cell (stable when the grid grows). Not serialized.
