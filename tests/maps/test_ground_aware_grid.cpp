@@ -612,6 +612,53 @@ TEST(GroundAwareGrid, AnEchoInACellScansHaveSeenThroughIsTakenForNoise)
 	}
 }
 
+TEST(GroundAwareGrid, AScanIsJudgedOnEveryCellItReaches)
+{
+	// insert2D() compares only the cells a scan can reach (a box around the
+	// sensor). On a fresh grid a scan's own evidence is all there is, so every
+	// cell must hold min(0, what MRPT's beam model did there on a stock grid):
+	// a cell the box missed would keep the beam model's free evidence (> 0).
+	// Scans that grow the grid, cross the +-180 deg line, and widen their
+	// beams or take invalid ranges as free space, which reach farther.
+	struct Case
+	{
+		double apertureDeg, robotX, robotY, robotYaw;
+		bool widen, invalidAsFree;
+	};
+	for (const Case& c :
+		 {Case{360, 4.0, 0.5, 0.0, false, false}, Case{360, 4.0, 0.5, 0.0, true, true},
+		  Case{90, -3.5, 0.5, 3.0, false, true}, Case{90, 1.0, -4.0, -2.0, true, false}})
+	{
+		auto s = planarScan(c.apertureDeg, 181, CPose3D(0.2, 0, 0.3, 0, 0, 0));
+		for (size_t i = 0; i < 181; i++) s.setScanRange(i, 2.0f + 0.01f * float(i % 50));
+		for (size_t i = 0; i < 181; i += 7) s.setScanRangeValidity(i, false);
+		const CPose3D robot(c.robotX, c.robotY, 0, c.robotYaw, 0, 0);
+		CGroundAwareOccupancyGrid g(-5, 5, -5, 5, 0.05f);
+		setScanRule(g, ScanRule::KeepCameraFloor);
+		COccupancyGridMap2D stock(-5, 5, -5, 5, 0.05f);
+		for (COccupancyGridMap2D* m : {static_cast<COccupancyGridMap2D*>(&g), &stock})
+		{
+			m->insertionOptions.wideningBeamsWithDistance = c.widen;
+			m->insertionOptions.considerInvalidRangesAsFreeSpace = c.invalidAsFree;
+			m->insertionOptions.maxDistanceInsertion = 50;
+			m->insertObservation(s, robot);
+		}
+		ASSERT_EQ(g.getSizeX(), stock.getSizeX());
+		ASSERT_EQ(g.getSizeY(), stock.getSizeY());
+		ASSERT_GT(g.getSizeX() + g.getSizeY(), 400u) << "the scan grew the grid";
+		int reached = 0, wrong = 0;
+		for (size_t i = 0; i < stock.getRawMap().size(); i++)
+		{
+			const int want = std::min(0, int(stock.getRawMap()[i]));
+			reached += stock.getRawMap()[i] != 0;
+			wrong += int(g.getRawMap()[i]) != want;
+		}
+		EXPECT_GT(reached, 1000);
+		EXPECT_EQ(wrong, 0) << "aperture " << c.apertureDeg << ", yaw " << c.robotYaw << ", widened " << c.widen
+							<< ", invalid as free " << c.invalidAsFree;
+	}
+}
+
 TEST(GroundAwareGrid, MalformedObservationsThrowClearErrors)
 {
 	auto obs = testscene::renderDepth(holeAndBoxScene(), kKinect);

@@ -360,6 +360,7 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	// since): the cell holds the rest plus min(0, ledger), see insert2D().
 	// State of a run: not serialized, so a loaded map's obstacles all stay.
 	COccupancyGridMap2D m_scanOnlyLayer;
+	std::vector<cellType> m_scanBefore;  ///< insert2D()'s copy of the cells a scan can reach (scratch)
 	// obstacle_decay_s: last time each positive obstacle cell was seen as one,
 	// keyed by its world cell (stable when the grid grows). Not serialized.
 	std::unordered_map<int64_t, double> m_positiveSeen;
