@@ -556,10 +556,11 @@ TEST(GroundAwareGrid, AnEchoInACellScansHaveSeenThroughIsTakenForNoise)
 	// said there plus min(0, the scans' echoes net of the rays passing since),
 	// and an echo in a cell that scans have seen through since its last echo
 	// adds nothing (the range noise of the surface behind it). MRPT's own beam
-	// model on a stock grid gives each scan's log-odds step (the oracle).
-	// 65 beams 0.025 rad apart from (0, 0.025): only the middle one (angle 0)
-	// crosses the cell [2.00, 2.05) x [0, 0.05); its neighbours are at y =
-	// 0.025 +- 2 tan 0.025 = 0.075 / -0.025 there.
+	// model on a stock grid gives each scan's log-odds step in the cell
+	// [2.00, 2.05) x [0, 0.05) (the oracle): a fan of 65 beams from (0, 0.025)
+	// ending at 2.025 m or passing it at 4 m. How many of MRPT's rays end in
+	// or cross that cell (it steps aperture / N from one edge) does not
+	// matter: both grids get the same scans.
 	auto fan = [](float range) {
 		auto s = planarScan(mrpt::RAD2DEG(64 * 0.025), 65, CPose3D(0, 0.025, 0.3, 0, 0, 0));
 		for (size_t i = 0; i < 65; i++) s.setScanRange(i, range);

@@ -109,16 +109,14 @@ bool isObstacle(Label l) { return l == Label::Obstacle || l == Label::Drop; }
 std::vector<uint8_t> objectCells(const GroundTruth& gt)
 {
 	std::vector<uint8_t> solid(gt.label.size(), 0);
-	std::map<int, bool> notRamp;
-	for (const GtObject& o : gt.objects) notRamp[o.id] = o.category != "ramp";
 	for (size_t i = 0; i < solid.size(); i++)
 	{
 		if (isObstacle(gt.label[i]))
 			solid[i] = 1;
 		else if (gt.label[i] == Label::Unobserved && gt.objectId[i] != 0)
 		{
-			const auto it = notRamp.find(gt.objectId[i]);
-			solid[i] = it != notRamp.end() && it->second;
+			const GtObject* o = gt.object(gt.objectId[i]);
+			solid[i] = o && o->category != "ramp";
 		}
 	}
 	return solid;

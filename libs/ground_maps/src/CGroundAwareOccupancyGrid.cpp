@@ -575,8 +575,10 @@ bool CGroundAwareOccupancyGrid::insert2D(
 		{
 			const int cx = nx - ox, cy = ny - oy;
 			const bool wasThere = cx >= 0 && cy >= 0 && cx < sx0 && cy < sy0;
-			// (The box before the scan holds every such cell: both ranges are
-			// the same world box, a cell wider than the round-off between them.)
+			// (Both ranges are the same world box with a cell to spare, so the
+			// copy holds every cell the scan changed; a rim cell that the
+			// round-off between the two grids' origins leaves outside the copy
+			// was not reached, and its value now is its value before.)
 			const cellType old = !wasThere ? cellType(0)
 								 : (cx >= bx0 && cx < bx1 && cy >= by0 && cy < by1)
 									 ? m_scanBefore[size_t(cy - by0) * size_t(bw) + size_t(cx - bx0)]
