@@ -133,8 +133,9 @@ struct IsmParams
 	 * with fewer samples give no evidence. The lower floor past a downward
 	 * step or a hole's bottom is seen at grazing incidence like the floor
 	 * itself: 4 m away a cell of it holds one or two samples, and each such
-	 * cell is the only sign of a fall there (min_obstacle_points = 3 for
-	 * drops cut the approach range of a 5 cm step 4.40 -> 3.70 m). */
+	 * cell is the only sign of a fall there (at 15e3fb1, 2026-11-25, 3 for
+	 * drops cut the approach range of a 5 cm step 4.40 -> 3.70 m; at 5946612,
+	 * 2026-11-27, 3 changes no detection range: doc/rules.md, I12). */
 	int min_drop_points = 2;
 	/** Voxels whose bottom is more than this above the ground do not block
 	 * (ceiling, door frames, beams above the robot). [m] */
