@@ -569,12 +569,10 @@ TEST(InverseSensorModel, ASpikeAmongFloorSamplesIsNoObstacle)
 	// A cell of 20 floor samples and spikes at +0.3 m (or -0.3 m), no 3-sigma
 	// rule: its top (bottom) is far beyond the band (0.0407, see
 	// handDeepThreshold), so the cell is an obstacle (drop) by z_max (z_min).
-	// With the frame's samples an obstacle counts only if
-	// min_obstacle_points = 3 of them lie beyond the band, a drop below the
-	// ground plane if min_drop_points = 2 do; a drop ray needs
+	// With the frame's samples an obstacle or a drop counts only if
+	// min_obstacle_points = 3 of them lie beyond the band; a drop ray needs
 	// drop_ray_min_points = 3.
 	ASSERT_EQ(deepParams().min_obstacle_points, 3);
-	ASSERT_EQ(deepParams().min_drop_points, 2);
 	ASSERT_EQ(deepParams().drop_ray_min_points, 3);
 	InverseSensorModel ism(deepParams());
 	IsmStats st;
@@ -603,24 +601,26 @@ TEST(InverseSensorModel, ASpikeAmongFloorSamplesIsNoObstacle)
 	EXPECT_EQ(st.sparse, 1u);
 	const ElevationGrid down2 = deepCellFrame(20, {-0.3f, -0.31f}, b);
 	ism.compute(down2, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
-	EXPECT_EQ(st.drop, 1u);
-	EXPECT_GT(ism.evidence()[cell], 0.5f);
-	EXPECT_EQ(st.drop_ray_cells, 0u) << "two samples below: evidence, no ray";
+	EXPECT_EQ(st.drop, 0u);
+	EXPECT_EQ(st.sparse, 1u);
+	EXPECT_EQ(ism.evidence()[cell], 0.5f) << "two spikes below: no evidence";
 	const ElevationGrid down3 = deepCellFrame(20, {-0.3f, -0.31f, -0.32f}, b);
 	ism.compute(down3, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
 	EXPECT_EQ(st.drop, 1u);
+	EXPECT_GT(ism.evidence()[cell], 0.5f);
 	EXPECT_GT(st.drop_ray_cells, 0u) << "three below: the ray is cast";
 }
 
-TEST(InverseSensorModel, ADropBelowAPatchTakesTheObstacleCount)
+TEST(InverseSensorModel, ADropTakesTheObstacleCountBelowAPatchAndBelowTheFloor)
 {
 	// The floor z = 0 and a landing patch z = 0.20 with a node at the cell
 	// (kDeepX, kDeepY). The cell's samples at z = 0.12 are 0.08 below the
 	// landing and 0.12 above the floor: it is judged against the landing (the
 	// plane it fits best) and is a drop there (0.08 > the ~4 cm band). Below
 	// a patch that is what the far side of a ramp looks like at grazing
-	// incidence, so it takes min_obstacle_points = 3 samples; the same two
-	// samples 0.08 below the floor plane are a drop (min_drop_points = 2).
+	// incidence, so it takes min_obstacle_points = 3 samples; so do samples
+	// 0.08 below the floor plane (a drop below the ground plane took 2 until
+	// 2026-11-27: doc/rules.md, I12).
 	GroundDetection det = handDetection(kFloor);
 	det.planes.push_back(Plane{0, 0, 1, -0.20});
 	det.plane_support.push_back(10);
@@ -646,8 +646,12 @@ TEST(InverseSensorModel, ADropBelowAPatchTakesTheObstacleCount)
 	const ElevationGrid belowFloor = deepCellFrame(0, {-0.08f, -0.08f}, b);
 	ism.compute(belowFloor, det, {0, 0, 1}, 5.0, st, &b);
 	EXPECT_EQ(ism.classes()[cell], VoxelClass::Drop);
+	EXPECT_EQ(st.drop, 0u);
+	EXPECT_EQ(ism.evidence()[cell], 0.5f) << "two samples below the floor plane: no evidence";
+	const ElevationGrid belowFloor3 = deepCellFrame(0, {-0.08f, -0.08f, -0.08f}, b);
+	ism.compute(belowFloor3, det, {0, 0, 1}, 5.0, st, &b);
 	EXPECT_EQ(st.drop, 1u);
-	EXPECT_GT(ism.evidence()[cell], 0.5f) << "two samples below the floor plane: a drop";
+	EXPECT_GT(ism.evidence()[cell], 0.5f) << "three samples below the floor plane: a drop";
 }
 
 TEST(InverseSensorModel, PatchAppliesWithinTheSupportRadiusOfItsNodes)
@@ -724,7 +728,6 @@ TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
 	const GridGeometry& g = frame.geometry();
 	IsmParams p;
 	p.min_obstacle_points = 1;  // the hole cells have one sample each (see LoneSamples... below)
-	p.min_drop_points = 1;
 	InverseSensorModel ism(p);
 	IsmStats st;
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 4.0, st);  // max range 4 m
@@ -900,7 +903,7 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	const ElevationGrid frame = stepFrame();
 	const GridGeometry& g = frame.geometry();
 	IsmParams prm;
-	prm.min_drop_points = 1;  // the lower floor has one sample per cell
+	prm.min_obstacle_points = 1;  // the lower floor has one sample per cell
 	IsmStats st;
 	// By default a drop voxel needs 3 samples to cast a ray: these have one.
 	InverseSensorModel strict(prm);
@@ -964,7 +967,6 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 
 	IsmParams p;
 	p.min_obstacle_points = 1;
-	p.min_drop_points = 1;
 	p.drop_ray_min_points = 1;
 	// Disabled: the gap stays unknown, the drop voxels still count.
 	p.drop_rays = false;
@@ -1031,10 +1033,10 @@ TEST(InverseSensorModel, DropRayIsNotCastThroughAnObstacle)
 TEST(InverseSensorModel, DropRayMinPoints)
 {
 	// Default drop_ray_min_points = 3: lower cells with 3 samples cast rays,
-	// with 2 they are still drops (min_drop_points = 2) but cast none.
-	const IsmParams p;
+	// with 2 they are still drops (min_obstacle_points = 2 here) but cast none.
+	IsmParams p;
 	ASSERT_EQ(p.drop_ray_min_points, 3);
-	ASSERT_EQ(p.min_drop_points, 2);
+	p.min_obstacle_points = 2;
 	InverseSensorModel ism(p);
 	IsmStats st;
 	const ElevationGrid three = stepFrame(3);
@@ -1064,7 +1066,6 @@ TEST(InverseSensorModel, NeutralEvidenceIsNeverListed)
 	p.K_m = 0;
 	p.drop_ray_min_points = 1;  // the lower cells have one sample: let them cast rays
 	p.min_obstacle_points = 1;
-	p.min_drop_points = 1;
 	InverseSensorModel ism(p);
 	IsmStats st;
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
@@ -1149,12 +1150,11 @@ TEST(InverseSensorModel, RampIsGroundOnlyWithLocalPlanes)
 TEST(InverseSensorModel, LoneSamplesGiveNoObstacleEvidence)
 {
 	// The hole cells of the scene frame hold one sample each: with the default
-	// min_drop_points = 2 they are classified but give no evidence, like a
-	// depth spike; the 5-sample box (min_obstacle_points = 3) still does.
+	// min_obstacle_points = 3 they are classified but give no evidence, like a
+	// depth spike; the 5-sample box still does.
 	const ElevationGrid frame = sceneFrame();
 	const GridGeometry& g = frame.geometry();
 	IsmParams p;
-	ASSERT_EQ(p.min_drop_points, 2);
 	ASSERT_EQ(p.min_obstacle_points, 3);
 	InverseSensorModel ism(p);
 	IsmStats st;
@@ -1166,8 +1166,6 @@ TEST(InverseSensorModel, LoneSamplesGiveNoObstacleEvidence)
 	p.min_obstacle_points = 0;
 	EXPECT_THROW(InverseSensorModel{p}, std::invalid_argument);
 	p.min_obstacle_points = 3;
-	p.min_drop_points = 0;
-	EXPECT_THROW(InverseSensorModel{p}, std::invalid_argument);
 }
 
 TEST(InverseSensorModel, FloorNoiseIsMeasuredPerRangeBin)

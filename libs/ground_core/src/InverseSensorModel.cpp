@@ -450,7 +450,7 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 		// samples beyond the band as any other (a lone spike among floor
 		// samples is no obstacle, and casts no ray).
 		const bool drop = d.kind == TailKind::Below;
-		if (k < minPoints(drop ? VoxelClass::Drop : VoxelClass::Obstacle, d.onPatch))
+		if (k < minPoints())
 		{
 			stats.sparse++;
 			continue;
@@ -558,20 +558,18 @@ void InverseSensorModel::compute(
 		VoxelClass cls;
 		double dMean = 0;
 		bool deferred = false;  // decided once its samples beyond the band are counted
-		bool onPatch = false;   // judged against a ramp or landing patch, not the ground plane
 		if (dx * dx + dy * dy > maxR2)
 			cls = VoxelClass::OutOfRange;
 		else
 		{
 			const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
 			const Plane& pl = choosePlane(det, c, x, y, block);
-			onPatch = &pl != &det.planes.front();
 			const double hs = pl.signedDistance(sensor.x(), sensor.y(), sensor.z());
 			const double band = groundBand(sensor, hs, x, y, c.mean());
 			const double tau = floorOffset(sensor, x, y, c.mean());
 			cls = classify(c, x, y, pl, band, dMean, tau);
 			if (haveSamples && pl.c > 0 && (cls == VoxelClass::Obstacle || cls == VoxelClass::Drop) &&
-				c.count >= minPoints(cls, onPatch))
+				c.count >= minPoints())
 			{
 				// Judged by its top (bottom) sample while others lie in the band:
 				// count the samples beyond the band before it counts.
@@ -579,13 +577,13 @@ void InverseSensorModel::compute(
 				if (cls == VoxelClass::Obstacle && top > band && bottom <= band)
 				{
 					m_tailHi[idx] = float(pl.heightAt(x, y) + band / pl.c);
-					m_tailCandidates.push_back({idx, TailKind::Above, 0.f, onPatch});
+					m_tailCandidates.push_back({idx, TailKind::Above, 0.f});
 					deferred = true;
 				}
 				else if (cls == VoxelClass::Drop && bottom < -band && top >= -band)
 				{
 					m_tailLo[idx] = float(pl.heightAt(x, y) - band / pl.c);
-					m_tailCandidates.push_back({idx, TailKind::Below, 0.f, onPatch});
+					m_tailCandidates.push_back({idx, TailKind::Below, 0.f});
 					deferred = true;
 				}
 			}
@@ -615,7 +613,7 @@ void InverseSensorModel::compute(
 					// has them far below its level.
 					double p0 = ism::normalTail(T / s);
 					if (sharedNoise && sigma > 0) p0 = std::max(p0, ism::normalTail((T + dMean) / sigma));
-					m_tailCandidates.push_back({idx, TailKind::Deep, float(p0), false});
+					m_tailCandidates.push_back({idx, TailKind::Deep, float(p0)});
 				}
 			}
 		}
@@ -629,7 +627,7 @@ void InverseSensorModel::compute(
 				break;
 			case VoxelClass::Obstacle:
 			case VoxelClass::Drop: {
-				if (c.count < minPoints(cls, onPatch))
+				if (c.count < minPoints())
 				{
 					// A lone return (a depth spike) is no evidence of anything.
 					stats.sparse++;

@@ -75,6 +75,7 @@ const char* retiredKeyReason(const std::string& suffix, const std::string& key)
 		{"_groundOpts", "max_fit_rms", "a local fit is judged by its tilt (N_th) alone (the RMS limit changed no map)"},
 		{"_groundOpts", "missing_floor_min_range",
 		 "a missing-floor region needs seen floor nearer along its rays, which covers it"},
+		{"_groundOpts", "min_drop_points", "a drop takes min_obstacle_points, as an obstacle does"},
 	};
 	for (const Retired& r : kRetired)
 		if (suffix == r.suffix && gam::iequals(key, r.key)) return r.why;

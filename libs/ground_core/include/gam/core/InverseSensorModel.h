@@ -123,20 +123,13 @@ struct IsmParams
 	 * per cell sit a few cm off the landing's plane or above the floor's. A
 	 * lone depth spike or flying pixel gives one sample, a pair of them two.
 	 * So 3 (it was 2 for both kinds: floor false obstacles in door_opening
-	 * 0.62 -> 0.35 %, see doc/benchmark.md). A drop below a ramp or landing
-	 * patch takes this count too: seen from afar, the far side of the ramp
-	 * is such a drop. A voxel judged by its top (bottom) sample while others
+	 * 0.62 -> 0.35 %, see doc/benchmark.md). A drop takes this count too:
+	 * seen from afar, the far side of a ramp is such a drop (a drop below the
+	 * ground plane took 2 until 2026-11-27; the steps and holes it was for are
+	 * marked as far with 3, doc/rules.md I12). A voxel judged by its top (bottom) sample while others
 	 * lie in the band needs this many samples beyond the band (given the
 	 * frame's samples): a spike among floor samples is no obstacle. */
 	int min_obstacle_points = 3;
-	/** Drop voxels below the ground plane (the floor the robot stands on)
-	 * with fewer samples give no evidence. The lower floor past a downward
-	 * step or a hole's bottom is seen at grazing incidence like the floor
-	 * itself: 4 m away a cell of it holds one or two samples, and each such
-	 * cell is the only sign of a fall there (at 15e3fb1, 2026-11-25, 3 for
-	 * drops cut the approach range of a 5 cm step 4.40 -> 3.70 m; at 5946612,
-	 * 2026-11-27, 3 changes no detection range: doc/rules.md, I12). */
-	int min_drop_points = 2;
 	/** Voxels whose bottom is more than this above the ground do not block
 	 * (ceiling, door frames, beams above the robot). [m] */
 	double robot_height = 1.8;
@@ -201,12 +194,6 @@ struct IsmParams
 				"min_obstacle_points", 1, 1000000,
 				"obstacle/drop voxels with fewer samples are ignored (depth spikes)"},
 			p.min_obstacle_points);
-		visit(
-			ParamInfo{
-				"min_drop_points", 1, 1000000,
-				"drop voxels below the ground plane with fewer samples are ignored (below a patch: "
-				"min_obstacle_points)"},
-			p.min_drop_points);
 		visit(
 			ParamInfo{
 				"measure_floor_noise", 0, 1,
@@ -327,7 +314,7 @@ enum class VoxelClass : uint8_t
 struct IsmStats
 {
 	size_t ground = 0, obstacle = 0, drop = 0, overhead = 0, out_of_range = 0;
-	size_t sparse = 0;  ///< obstacle/drop voxels below min_obstacle_points / min_drop_points: ignored
+	size_t sparse = 0;  ///< obstacle/drop voxels below min_obstacle_points: ignored
 	size_t drop_ray_cells = 0;
 	size_t drop_rays_unsupported = 0;  ///< drop rays not cast: an obstacle stood between the sensor and the crossing
 	size_t deep_drops = 0;             ///< drops found by the deep-sample count alone
@@ -455,12 +442,8 @@ class InverseSensorModel
 	double m_fx = 0;
 	Eigen::Vector3d m_rangeAxis = Eigen::Vector3d::Zero();          ///< setCameraRangeLimit
 	double m_rangeLimit = std::numeric_limits<double>::infinity();  ///< setCameraRangeLimit [m]
-	/** Samples an obstacle (min_obstacle_points) or a drop (min_drop_points) needs. */
-	uint32_t minPoints(VoxelClass c, bool onPatch) const
-	{
-		return uint32_t(
-			std::max(1, c == VoxelClass::Drop && !onPatch ? m_params.min_drop_points : m_params.min_obstacle_points));
-	}
+	/** Samples an obstacle or a drop voxel needs (min_obstacle_points). */
+	uint32_t minPoints() const { return uint32_t(std::max(1, m_params.min_obstacle_points)); }
 	void buildSupport(const GridGeometry& g, const GroundDetection& det);
 	/** deep_sample_test: counts each candidate cell's kept samples below its
 	 * threshold, then turns the cells that pass into drops. */
@@ -537,7 +520,6 @@ class InverseSensorModel
 		uint32_t cell;
 		TailKind kind;
 		float p0;
-		bool onPatch;  ///< judged against a ramp or landing patch (minPoints)
 	};
 	std::vector<TailCandidate> m_tailCandidates;
 	std::vector<Held> m_held;  ///< obstacle and drop cells waiting for range_smear
