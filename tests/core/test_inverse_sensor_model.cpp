@@ -1165,7 +1165,6 @@ TEST(InverseSensorModel, LoneSamplesGiveNoObstacleEvidence)
 	EXPECT_GT(ism.evidence()[g.index(g.ix(1.25), g.iy(0.55))], 0.5f);
 	p.min_obstacle_points = 0;
 	EXPECT_THROW(InverseSensorModel{p}, std::invalid_argument);
-	p.min_obstacle_points = 3;
 }
 
 TEST(InverseSensorModel, FloorNoiseIsMeasuredPerRangeBin)

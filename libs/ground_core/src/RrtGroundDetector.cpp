@@ -224,8 +224,8 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 	// tilted down to the floor, 3 tree nodes, and the floor beyond an extra
 	// patch; in another draw of the tree, min_nodes or more, but less than
 	// half of the tree: 5.6 % of a held-out scene's floor occupied). A tree from
-	// another seed replaces that one only if its ground plane holds
-	// min_nodes and passes nearer the floor the robot stands on, at the
+	// another seed replaces that one only if its ground plane holds as many
+	// (`enough`) and passes nearer the floor the robot stands on, at the
 	// robot: else the robot may stand at the foot of a ramp whose floor
 	// shows few nodes, and the first tree (that floor) is grown again.
 	const int attempts = paper() ? 1 : m_params.seed_attempts;

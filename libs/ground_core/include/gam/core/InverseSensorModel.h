@@ -125,10 +125,11 @@ struct IsmParams
 	 * So 3 (it was 2 for both kinds: floor false obstacles in door_opening
 	 * 0.62 -> 0.35 %, see doc/benchmark.md). A drop takes this count too:
 	 * seen from afar, the far side of a ramp is such a drop (a drop below the
-	 * ground plane took 2 until 2026-11-27; the steps and holes it was for are
-	 * marked as far with 3, doc/rules.md I12). A voxel judged by its top (bottom) sample while others
-	 * lie in the band needs this many samples beyond the band (given the
-	 * frame's samples): a spike among floor samples is no obstacle. */
+	 * ground plane took 2 until 2026-11-27; the steps and holes it was for
+	 * are marked as far with 3, doc/rules.md I12). A voxel judged by its top
+	 * (bottom) sample while others lie in the band needs this many samples
+	 * beyond the band (given the frame's samples): a spike among floor
+	 * samples is no obstacle. */
 	int min_obstacle_points = 3;
 	/** Voxels whose bottom is more than this above the ground do not block
 	 * (ceiling, door frames, beams above the robot). [m] */
