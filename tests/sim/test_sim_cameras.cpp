@@ -272,6 +272,43 @@ TEST(SimCameras, TimeOfFlightMultipathPushesTheFloorAwayAtAWallsFoot)
 	EXPECT_EQ(sigmaScale, 2.0);
 }
 
+TEST(SimCameras, ACameraWithoutALabelIsLabelledAfterItsModel)
+{
+	// The map's camera_model = auto tells a D455 from a D435 by the label only
+	// (both 848x480 at 87 deg), so a camera the scene does not label carries its
+	// model's name; the Kinect One keeps "KINECT", the label of every older rawlog.
+	const std::string pose = "kinect pose=0.1,0,1,0,25,0";
+	EXPECT_EQ(parse(pose + "\n").kinect_label, "KINECT");
+	EXPECT_EQ(parse(pose + " model=d435\n").kinect_label, "D435");
+	EXPECT_EQ(parse(pose + " model=d455\n").kinect_label, "D455");
+	EXPECT_EQ(parse(pose + " model=femto\n").kinect_label, "FEMTO");
+	EXPECT_EQ(parse(pose + " model=astra\n").kinect_label, "ASTRA");
+	// --camera relabels the cameras the scene did not label, and back.
+	SceneFile sf = parse(pose + "\n" + pose + " label=DOWN\n");
+	setCameraModel(sf, CameraModel::D455);
+	EXPECT_EQ(sf.kinect_label, "D455");
+	ASSERT_EQ(sf.more_kinects.size(), 1u);
+	EXPECT_EQ(sf.more_kinects[0].label, "DOWN");  // the scene's own label stays
+	setCameraModel(sf, CameraModel::KinectOne);
+	EXPECT_EQ(sf.kinect_label, "KINECT");
+	// Two cameras never share a label: the second unlabelled one keeps its own
+	// when the model's name is taken by the first.
+	SceneFile two = parse(pose + " label=D455\n" + pose + "\n");
+	EXPECT_EQ(two.more_kinects[0].label, "KINECT");
+	setCameraModel(two, CameraModel::D455);
+	EXPECT_EQ(two.kinect_label, "D455");
+	EXPECT_EQ(two.more_kinects[0].label, "KINECT");
+	try
+	{
+		parse(pose + " model=d455\n" + pose + " label=D455\n");
+		FAIL() << "a label given twice must be an error";
+	}
+	catch (const SceneError& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("duplicate camera label 'D455'"), std::string::npos) << e.what();
+	}
+}
+
 TEST(SimCameras, SceneAndCommandLineChooseTheModel)
 {
 	const SceneFile sf = parse("kinect pose=0.1,0,1,0,25,0 model=d455 max_range=5\n");

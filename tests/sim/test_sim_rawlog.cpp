@@ -126,6 +126,27 @@ TEST(SimRawlog, GamSimulateWritesALoadableRawlog)
 	EXPECT_LT(maxFaceErr, 0.002);
 }
 
+TEST(SimRawlog, CameraOptionLabelsTheFramesAfterTheModel)
+{
+	// --camera d455 on a scene that labels no camera: the frames say "D455", the
+	// only thing that tells them from a D435's (camera_model = auto reads the label).
+	const fs::path d = tmpDir();
+	const fs::path scene = d / "d455.scene";
+	{
+		std::ofstream f(scene);
+		f << "kinect pose=0.10,0,1.00,0,25,0\n"
+			 "path waypoints=0,0,0\n";
+	}
+	const std::string prefix = (d / "d455").string();
+	ASSERT_EQ(run("--scene " + scene.string() + " --out " + prefix + " --no-leddar --frames 1 --camera d455"), 0);
+	mrpt::obs::CRawlog rl;
+	ASSERT_TRUE(rl.loadFromRawLogFile(prefix + ".rawlog"));
+	auto k = rl.asObservation<mrpt::obs::CObservation3DRangeScan>(1);
+	ASSERT_TRUE(k);
+	EXPECT_EQ(k->sensorLabel, "D455");
+	EXPECT_EQ(k->cameraParams.ncols, 848u);
+}
+
 TEST(SimRawlog, BadSceneFileFailsWithFileAndLine)
 {
 	const fs::path d = tmpDir();

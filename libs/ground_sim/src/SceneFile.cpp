@@ -151,6 +151,18 @@ void setCameraModel(SceneFile& sf, CameraModel model)
 		applyCameraKeys(e.params, e.keys);
 		e.params.noise = n;
 	}
+	// Labels that follow the model follow it here too, unless that would give two
+	// cameras one label (the map keeps a pipeline and a mount per label).
+	auto taken = [&](const std::string& l) {
+		if (sf.kinect_label == l) return true;
+		for (const ExtraKinect& e : sf.more_kinects)
+			if (e.label == l) return true;
+		return false;
+	};
+	const std::string label = defaultCameraLabel(model);
+	if (!sf.kinect_label_given && !taken(label)) sf.kinect_label = label;
+	for (ExtraKinect& e : sf.more_kinects)
+		if (!e.label_given && !taken(label)) e.label = label;
 }
 
 namespace
@@ -261,7 +273,12 @@ void parseFloor(SceneBuilder& b, Args& a) { b.sf.scene.has_floor = a.num("presen
 void parseKinect(SceneBuilder& b, Args& a)
 {
 	SceneFile& sf = b.sf;
-	const std::string label = a.str("label", "KINECT");
+	CameraModel model = CameraModel::KinectOne;
+	const std::string modelName = a.str("model", "kinect_one");
+	if (!parseCameraModel(modelName, model))
+		a.fail("unknown model '" + modelName + "' (known: " + cameraModelNames() + ")");
+	const bool labelGiven = a.has("label");
+	const std::string label = labelGiven ? a.str("label") : defaultCameraLabel(model);
 	for (char c : label)
 		if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-')
 			a.fail("label must be letters, digits, _ or - (got '" + label + "')");
@@ -271,16 +288,17 @@ void parseKinect(SceneBuilder& b, Args& a)
 	// further one adds a camera to more_kinects.
 	const bool first = b.kinectLabels.size() == 1;
 	ExtraKinect extra;
-	if (first) sf.kinect_label = label;
+	if (first)
+	{
+		sf.kinect_label = label;
+		sf.kinect_label_given = labelGiven;
+	}
 	extra.label = label;
+	extra.label_given = labelGiven;
 	Pose3& pose = first ? sf.kinect_pose : extra.pose;
 	pose = poseOf(a.list("pose", 6));
 	auto& k = first ? sf.kinect : extra.params;
 	auto& keys = first ? sf.kinect_keys : extra.keys;
-	CameraModel model = CameraModel::KinectOne;
-	const std::string modelName = a.str("model", "kinect_one");
-	if (!parseCameraModel(modelName, model))
-		a.fail("unknown model '" + modelName + "' (known: " + cameraModelNames() + ")");
 	for (const char* key :
 		 {"noise_scale", "min_range", "max_range", "spike_prob", "flying_prob", "grazing_start", "grazing_end"})
 		if (a.has(key)) keys[key] = a.num(key, 0);

@@ -2,6 +2,7 @@
 #include "gam/sim/Sensors.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 namespace gam::sim
@@ -129,6 +130,14 @@ bool parseCameraModel(const std::string& name, CameraModel& model)
 }
 
 std::string cameraModelNames() { return "kinect_one, d435, d455, femto, astra"; }
+
+std::string defaultCameraLabel(CameraModel model)
+{
+	if (model == CameraModel::KinectOne) return "KINECT";
+	std::string l = cameraModelName(model);
+	for (char& c : l) c = char(std::toupper(static_cast<unsigned char>(c)));
+	return l;
+}
 
 double KinectParams::sigma(double z, double theta) const
 {

@@ -18,13 +18,14 @@ namespace gam::sim
 {
 /** A simulated Kinect frame as MRPT's CObservation3DRangeScan: depth along +X
  * in millimetres (0 = no return), pinhole intrinsics of `kinect`, `sensorPose`
- * on the robot. `validPixels` (optional) gets the number of non-zero pixels. */
+ * on the robot, labelled defaultCameraLabel(kinect.model) ("KINECT" for the
+ * Kinect One). `validPixels` (optional) gets the number of non-zero pixels. */
 inline mrpt::obs::CObservation3DRangeScan::Ptr toKinectObservation(
 	const KinectParams& kinect, const DepthFrame& fr, const mrpt::poses::CPose3D& sensorPose,
 	size_t* validPixels = nullptr)
 {
 	auto k = mrpt::obs::CObservation3DRangeScan::Create();
-	k->sensorLabel = "KINECT";
+	k->sensorLabel = defaultCameraLabel(kinect.model);
 	k->hasRangeImage = true;
 	k->range_is_depth = true;
 	k->rangeUnits = 0.001f;

@@ -12,7 +12,8 @@
 //
 //   floor present=1                      # present=0: no floor at all
 //   kinect pose=x,y,z,yaw,pitch,roll     # on the robot; pitch>0 looks down
-//          [label=KINECT]   # several kinect statements = several cameras, unique labels
+//          [label=KINECT]   # several kinect statements = several cameras, unique labels;
+//                           # default KINECT for kinect_one, else the model in capitals (D455)
 //          [model=kinect_one|d435|d455|femto|astra]  # the camera's preset (Sensors.h)
 //          [noise_scale=1] [min_range=0.5] [max_range=4.5] [spike_prob=1e-4]  # override the preset
 //          [flying_prob=0.5] [grazing_start=70] [grazing_end=85] [sway=0]
@@ -71,6 +72,7 @@ class SceneError : public std::runtime_error
 struct ExtraKinect
 {
 	std::string label;
+	bool label_given = false;  ///< label= was set (else it follows the model)
 	KinectParams params;
 	std::map<std::string, double> keys;  ///< the statement's settings beside model= (kept by setCameraModel)
 	Pose3 pose;
@@ -88,6 +90,7 @@ struct SceneFile
 	bool leddar_enabled = true;
 	double kinect_sway = 0;                 ///< radians, sigma of the per-frame pitch/roll perturbation
 	std::string kinect_label = "KINECT";    ///< sensorLabel of the main camera
+	bool kinect_label_given = false;        ///< label= was set (else it follows the model)
 	std::vector<ExtraKinect> more_kinects;  ///< the second, third... kinect statements
 	/** Write the per-frame ground truth (PREFIX_gt_frames.csv): 1 yes, 0 no, -1 = only
 	 * if an object appears, disappears or moves (grid per_frame=). */
@@ -102,7 +105,10 @@ struct SceneFile
  * min_range, max_range, spike_prob, flying_prob, grazing_start, grazing_end). */
 void applyCameraKeys(KinectParams& k, const std::map<std::string, double>& keys);
 /** Every camera of the scene becomes `model` (its preset), keeping the keys
- * its statement set and the noise switch (gam-simulate --camera). */
+ * its statement set and the noise switch (gam-simulate --camera). A camera
+ * whose statement set no label= takes defaultCameraLabel(model), unless
+ * another camera of the scene already carries that label (then it keeps its
+ * own). */
 void setCameraModel(SceneFile& sf, CameraModel model);
 
 /** Parses a scene; `filename` is used in the error messages only. */

@@ -119,6 +119,12 @@ const char* cameraModelName(CameraModel model);
 bool parseCameraModel(const std::string& name, CameraModel& model);
 /** The names, comma separated (for error messages). */
 std::string cameraModelNames();
+/** The sensorLabel of a camera whose scene statement names none: "KINECT" for
+ * the Kinect One (as before camera models existed), else the model's name in
+ * capitals ("D435", "D455", "FEMTO", "ASTRA"), so that the map's
+ * `camera_model = auto` reads the frames as the camera that took them. A D455
+ * frame has a D435's size and field of view: only its label tells them apart. */
+std::string defaultCameraLabel(CameraModel model);
 
 /** Per-pixel flags of a simulated depth frame. */
 enum PixelFlag : uint8_t
