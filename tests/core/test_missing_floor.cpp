@@ -394,6 +394,48 @@ TEST(MissingFloor, TheStereoInvalidBandIsNoEvidence)
 	EXPECT_TRUE(hole.det.isMissing(cellOf(10, 8)));
 }
 
+TEST(MissingFloor, FloorHiddenFromTheSecondImagerByANearerSurfaceIsNoEvidence)
+{
+	// fx = 80, baseline 0.05 m: fx b = 4 px m. A point at column c and depth
+	// z lands at column c - 4 / z in the second imager: the floor (1 m) at
+	// c - 4, a box top 0.5 m from the camera (rows 8-31, columns 20-27) at
+	// k - 8, i.e. columns 12-19 there. The floor pixels with c - 4 in 12..15
+	// and c left of the box, columns 16-19, are hidden behind it from the
+	// second imager (8 px of box disparity > 4 + 0.5): a stereo camera
+	// returns nothing there, 24 rows x 4 columns = 96 pixels. The same 96
+	// empty pixels right of the box (columns 28-31) are seen by both
+	// imagers (c - 4 = 24..27: only the floor lands there), so they are
+	// empty rays as a dark patch's would be.
+	Scene s;
+	for (int r = 8; r < 32; r++)
+	{
+		for (int c = 20; c < 28; c++) s.at(r, c) = 500;
+		for (int c = 16; c < 20; c++) s.at(r, c) = 0;
+		for (int c = 28; c < 32; c++) s.at(r, c) = 0;
+	}
+	// Read as a time-of-flight camera: every one of the 40 x 40 pixels is a
+	// ray (the box's too: their rays meet the floor), 2 x 96 of them empty.
+	Result tof;
+	run(s, tof);
+	EXPECT_EQ(tof.stats.rays, 1600u);
+	EXPECT_EQ(tof.stats.empty_rays, 192u);
+	// With the baseline the 96 hidden pixels are no rays at all.
+	Result stereo;
+	run(s, stereo, {}, 0.05);
+	EXPECT_EQ(stereo.stats.rays, 1600u - 96u);
+	EXPECT_EQ(stereo.stats.empty_rays, 96u);
+	// A box top 0.9 m from the camera (disparity 4000 / 900 = 4.44 px, within
+	// half a pixel of the floor's 4 px) hides nothing: it lands at
+	// lround(k - 4.44) = k - 4, columns 16-23, none of the hidden columns'
+	// 12-15, and it is not nearer by more than half a pixel anyway.
+	for (int r = 8; r < 32; r++)
+		for (int c = 20; c < 28; c++) s.at(r, c) = 900;
+	Result low;
+	run(s, low, {}, 0.05);
+	EXPECT_EQ(low.stats.rays, 1600u);
+	EXPECT_EQ(low.stats.empty_rays, 192u);
+}
+
 TEST(MissingFloor, EmptyRaysDoNotDependOnTheStatisticsRows)
 {
 	// A camera 1 m up, pitched 10 deg down and rolled 5 deg, fx = fy = 40 on

@@ -278,6 +278,43 @@ void MissingFloorDetector::compute(
 		const uint16_t* __restrict raw = img.data + size_t(r) * img.stride;
 		int prev = 0;  // previous pixel of the row: 0 none, 1 seen floor, 2 empty on seen floor
 		const bool statsRow = (r / step) % m_params.stats_row_step == 0;
+		// Whether the second imager's view of an empty pixel is hidden by a
+		// nearer surface of this row: a point at column k and disparity d_k
+		// lands at lround(k - d_k) there, the largest disparity reaching a
+		// column hides the others (a z-buffer, as the stereo matcher sees it).
+		// Only pixels k with d_k > d + 0.5 hide the pixel's column x =
+		// lround(c - d), and they lie in k <= x + 0.5 + d_max: a short scan
+		// right of c, bounded by the row's largest disparity (its nearest
+		// return, found once), that compares raw depths and divides only
+		// for the pixels near enough.
+		int nearestRaw = -1;
+		const double fbu = fxBaseline / double(units);
+		const auto hiddenFromSecondImager = [&](int c, double t) {
+			if (nearestRaw < 0)
+			{
+				uint16_t nearest = 65535;  // the smallest raw depth - 1 (0: no return, skipped)
+				for (int k = 0; k < cols; k++) nearest = std::min<uint16_t>(nearest, uint16_t(raw[k] - 1));
+				nearestRaw = nearest == 65535 ? 0 : nearest + 1;
+			}
+			const double d = fxBaseline / t;
+			const long x = std::lround(double(c) - d);
+			if (x < 0 || x >= cols || nearestRaw == 0) return false;
+			const float fbf = float(fbu);
+			const float dMax = fbf / float(nearestRaw);
+			if (!(double(dMax) > d + 0.5)) return false;
+			// d_k > d + 0.5 needs u_k < fbu / (d + 0.5): raw depths at or beyond
+			// the bound (two units of margin over the float division) cannot.
+			const double uBound = fbu / (d + 0.5) + 2.0;
+			const long kEnd = std::min<long>(cols - 1, x + 1 + long(std::ceil(dMax)));
+			for (long k = std::max(0L, long(c) - 1); k <= kEnd; k++)
+			{
+				const uint16_t u = raw[k];
+				if (u == 0 || double(u) >= uBound) continue;
+				const float dk = fbf / float(u);
+				if (double(dk) > d + 0.5 && std::lround(float(k) - dk) == x) return true;
+			}
+			return false;
+		};
 		// (The bounds hold for every n-th pixel of a decimated row too.)
 		const RowRays rowAll = rowRays(projector.rowRayBounds(r));
 		if (rowAll == RowRays::None) continue;  // no ray meets the ground within the range: no candidate
@@ -288,7 +325,9 @@ void MissingFloorDetector::compute(
 		// state (0 none, 1 seen floor, 2 empty on seen floor).
 		const auto countRay = [&](int c, double t, double expected, uint32_t cell, int before) {
 			const uint16_t v = raw[c];
-			if (v == 0 && fxBaseline > 0 && missing::outsideSecondImager(c, t, fxBaseline)) return 0;
+			if (v == 0 && fxBaseline > 0 &&
+				(missing::outsideSecondImager(c, t, fxBaseline) || hiddenFromSecondImager(c, t)))
+				return 0;
 			// (v > rawInRange: a return beyond the range, see rawInRange.)
 			const bool empty = v == 0 || (v > rawInRange && double(v) * units > expected + m_params.beyond_margin);
 			rayCount += statsRow;

@@ -129,8 +129,13 @@ class MissingFloorDetector
 	const MissingFloorParams& params() const { return m_params; }
 	/** The camera's stereo (or projector) baseline [m], second imager to the
 	 * image's right; 0 (time of flight) = every pixel could have returned.
-	 * With a baseline, empty pixels of depth images in the second imager's
-	 * invalid band are no evidence (missing::outsideSecondImager). */
+	 * With a baseline, empty pixels of depth images that the second imager
+	 * cannot see are no evidence: those in its invalid band at the image's
+	 * left edge (missing::outsideSecondImager) and those whose floor point a
+	 * nearer surface of the same row hides from it (the band left of a near
+	 * object: a point at column k and disparity d_k lands at lround(k - d_k)
+	 * there, and one more than half a pixel of disparity nearer than the
+	 * floor point hides it). */
 	void setSecondImagerBaseline(double baseline) { m_baseline = baseline > 0 ? baseline : 0; }
 
 	/** One depth frame (frame.has_image) after the 2.5D map, the ground and
