@@ -199,6 +199,9 @@ void MissingFloorDetector::compute(
 	// Depth from disparity: pixels in the second imager's invalid band return
 	// nothing whatever lies there (range images: not applied).
 	const double fxBaseline = img.is_depth ? K.fx * m_baseline : 0.0;
+	// Disparity [px] of a raw depth u: fbf / u (hiddenFromSecondImager).
+	const double fbu = fxBaseline / double(units);
+	const float fbf = float(fbu);
 
 	// 1. Every pixel whose ray meets the ground inside the range: one ray of
 	// the cell it meets; empty if the camera returned nothing there. Along
@@ -287,25 +290,21 @@ void MissingFloorDetector::compute(
 		// right of c, bounded by the row's largest disparity (its nearest
 		// return, found once), that compares raw depths and divides only
 		// for the pixels near enough.
-		int nearestRaw = -1;
-		const double fbu = fxBaseline / double(units);
+		float rowMaxDisparity = -1.f;  // the row's largest disparity (0: no return), found at first use
 		const auto hiddenFromSecondImager = [&](int c, double t) {
-			if (nearestRaw < 0)
+			if (rowMaxDisparity < 0.f)
 			{
 				uint16_t nearest = 65535;  // the smallest raw depth - 1 (0: no return, skipped)
 				for (int k = 0; k < cols; k++) nearest = std::min<uint16_t>(nearest, uint16_t(raw[k] - 1));
-				nearestRaw = nearest == 65535 ? 0 : nearest + 1;
+				rowMaxDisparity = nearest == 65535 ? 0.f : fbf / float(nearest + 1);
 			}
 			const double d = fxBaseline / t;
 			const long x = std::lround(double(c) - d);
-			if (x < 0 || x >= cols || nearestRaw == 0) return false;
-			const float fbf = float(fbu);
-			const float dMax = fbf / float(nearestRaw);
-			if (!(double(dMax) > d + 0.5)) return false;
+			if (x < 0 || x >= cols || !(double(rowMaxDisparity) > d + 0.5)) return false;
 			// d_k > d + 0.5 needs u_k < fbu / (d + 0.5): raw depths at or beyond
 			// the bound (two units of margin over the float division) cannot.
 			const double uBound = fbu / (d + 0.5) + 2.0;
-			const long kEnd = std::min<long>(cols - 1, x + 1 + long(std::ceil(dMax)));
+			const long kEnd = std::min<long>(cols - 1, x + 1 + long(std::ceil(rowMaxDisparity)));
 			for (long k = std::max(0L, long(c) - 1); k <= kEnd; k++)
 			{
 				const uint16_t u = raw[k];
