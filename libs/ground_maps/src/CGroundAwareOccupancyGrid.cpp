@@ -958,10 +958,29 @@ void CGroundAwareOccupancyGrid::applyEvidence(const gam::GroundAwarePipeline& pi
 	const float pMissing = float(0.5 + 0.5 * m_options.pipeline.ism.K_m);
 	const int sx = int(getSizeX()), sy = int(getSizeY());
 	syncLayer(m_scanOnlyLayer);
+	syncMissingLayer();
+	// A frame cell's grid cell, by column and row: x2idx() divides, and a
+	// frame has thousands of evidence cells in a few hundred columns and rows.
+	// (The same calls as per cell, so the same cells.)
+	m_colOf.resize(size_t(g.nx));
+	m_layerColOf.resize(size_t(g.nx));
+	for (int cx = 0; cx < g.nx; cx++)
+	{
+		m_colOf[size_t(cx)] = x2idx(g.cx(cx));
+		m_layerColOf[size_t(cx)] = m_missingLayer.x2idx(g.cx(cx));
+	}
+	m_rowOf.resize(size_t(g.ny));
+	m_layerRowOf.resize(size_t(g.ny));
+	for (int cy = 0; cy < g.ny; cy++)
+	{
+		m_rowOf[size_t(cy)] = y2idx(g.cy(cy));
+		m_layerRowOf[size_t(cy)] = m_missingLayer.y2idx(g.cy(cy));
+	}
+	const uint32_t nx = uint32_t(g.nx);
 	cellType* scanLedger = m_scanOnlyLayer.getRow(0);
 	const auto update = [&](uint32_t c, float pOcc) {
-		const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
-		const int wx = x2idx(g.cx(cx)), wy = y2idx(g.cy(cy));
+		const uint32_t cy = c / nx, cx = c - cy * nx;
+		const int wx = m_colOf[cx], wy = m_rowOf[cy];
 		if (wx < 0 || wy < 0 || wx >= sx || wy >= sy) return;
 		const float pFree = std::clamp(1.0f - pOcc, gam::ism::kEvidenceFloor, 1.0f - gam::ism::kEvidenceFloor);
 		const int l = int(p2l(pFree));
@@ -979,11 +998,10 @@ void CGroundAwareOccupancyGrid::applyEvidence(const gam::GroundAwarePipeline& pi
 
 	// The missing-floor layer: this frame's judgement replaces the old one;
 	// floor seen clears a cell.
-	syncMissingLayer();
 	const auto& cls = ism.classes();
 	const auto setLayer = [&](uint32_t c, float pFree) {
-		const int wx = m_missingLayer.x2idx(g.cx(int(c % uint32_t(g.nx))));
-		const int wy = m_missingLayer.y2idx(g.cy(int(c / uint32_t(g.nx))));
+		const uint32_t cy = c / nx, cx = c - cy * nx;
+		const int wx = m_layerColOf[cx], wy = m_layerRowOf[cy];
 		if (wx < 0 || wy < 0 || wx >= sx || wy >= sy) return;
 		m_missingLayer.setCell(unsigned(wx), unsigned(wy), pFree);
 	};

@@ -361,6 +361,9 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 	// State of a run: not serialized, so a loaded map's obstacles all stay.
 	COccupancyGridMap2D m_scanOnlyLayer;
 	std::vector<cellType> m_scanBefore;  ///< insert2D()'s copy of the cells a scan can reach (scratch)
+	// applyEvidence(): the grid's and the missing-floor layer's column (row)
+	// of each column (row) of the frame grid, for this frame (scratch).
+	std::vector<int> m_colOf, m_rowOf, m_layerColOf, m_layerRowOf;
 	// obstacle_decay_s: last time each positive obstacle cell was seen as one,
 	// keyed by its world cell (stable when the grid grows). Not serialized.
 	std::unordered_map<int64_t, double> m_positiveSeen;
