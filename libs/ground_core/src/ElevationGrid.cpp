@@ -101,6 +101,23 @@ inline void accumulate(ElevationGrid::FrameCell& a, float z)
 	a.z_max = std::max(a.z_max, z);
 }
 
+// f(i) for every i in [0, n): the four quarters of the range in lockstep,
+// then the rest. (Each f updates a cell that the next index mostly updates
+// too, after waiting for its store: four such chains overlap.)
+template <class F>
+inline void inLockstepQuarters(size_t n, F&& f)
+{
+	const size_t q = n / 4;
+	for (size_t i = 0; i < q; i++)
+	{
+		f(i);
+		f(q + i);
+		f(2 * q + i);
+		f(3 * q + i);
+	}
+	for (size_t i = 4 * q; i < n; i++) f(i);
+}
+
 ElevationCell toCell(const ElevationGrid::FrameCell& a)
 {
 	ElevationCell c;
@@ -134,15 +151,7 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 		if (!a.count) m_frameTouched.push_back(cellOf[i]);
 		accumulate(a, zOf[i]);
 	};
-	const size_t q = n / 4;
-	for (size_t i = 0; i < q; i++)
-	{
-		add(i);
-		add(q + i);
-		add(2 * q + i);
-		add(3 * q + i);
-	}
-	for (size_t i = 4 * q; i < n; i++) add(i);
+	inLockstepQuarters(n, add);
 
 	// Per cell, the band mean +- k*std; cells whose samples all lie in it (or
 	// that are too small for the rule) are merged as they are; the others are
@@ -179,15 +188,7 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 			else
 				kept--;
 		};
-		const size_t q = listed / 4;
-		for (size_t k = 0; k < q; k++)
-		{
-			readd(k);
-			readd(q + k);
-			readd(2 * q + k);
-			readd(3 * q + k);
-		}
-		for (size_t k = 4 * q; k < listed; k++) readd(k);
+		inLockstepQuarters(listed, readd);
 	}
 
 	// Merge into the grid and reset the scratch cells.
