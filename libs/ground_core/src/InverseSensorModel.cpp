@@ -713,7 +713,8 @@ void InverseSensorModel::compute(
 		}
 		const float p = m_evidence[idx];
 		const int steps = int(std::ceil(len / (0.5 * res)));
-		// March in cell units from the voxel back along the ray (no division per step).
+		// March in cell units from the voxel back along the ray (no division by the
+		// resolution per step; the step's fraction s / steps is one division).
 		const double vx = (x - g.x_min) / res, vy = (y - g.y_min) / res;
 		const double sx = lx / res, sy = ly / res;
 		// The cells of the steps first, in a loop without branches (it
