@@ -313,7 +313,8 @@ int main(int argc, char** argv)
 			{"1_projection", &gam::StageTimes::projection},
 			{"2_outlier_filter", &gam::StageTimes::outliers},
 			{"3_rrt_gpd", &gam::StageTimes::ground},
-			{"4_ism", &gam::StageTimes::ism}};
+			{"4_ism", &gam::StageTimes::ism},
+			{"4_missing_floor", &gam::StageTimes::missing}};
 		for (const auto& [name, stage] : stageCases)
 			benchmark::RegisterBenchmark((n + name).c_str(), BM_Stage, &d, stage)
 				->UseManualTime()

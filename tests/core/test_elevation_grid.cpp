@@ -490,3 +490,20 @@ TEST(ElevationGrid, SamplesInMarkedCellsAreListedInOrder)
 	BinnedPoints empty;
 	EXPECT_EQ(samplesInMarkedCells(empty, marked, out), 0u);
 }
+
+TEST(ElevationGrid, FewMarkedSkipsBlocksWithoutAMarkedCellButListsTheSame)
+{
+	// 40 samples: 0-15 in cell 0 (a block of 16 with no marked cell), 20 and
+	// 37 in cell 1 (marked; 37 lies in the 8 left over after two blocks), the
+	// rest in cell 2. Both ways list samples 20 and 37, in order.
+	BinnedPoints b;
+	for (uint32_t i = 0; i < 40; i++) b.push(i < 16 ? 0u : (i == 20 || i == 37) ? 1u : 2u, 0.f);
+	const uint8_t marked[3] = {0, 1, 0};
+	for (bool few : {false, true})
+	{
+		std::vector<uint32_t> out;
+		ASSERT_EQ(samplesInMarkedCells(b, marked, out, few), 2u) << "fewMarked " << few;
+		EXPECT_EQ(out[0], 20u);
+		EXPECT_EQ(out[1], 37u);
+	}
+}

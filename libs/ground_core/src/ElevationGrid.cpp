@@ -156,7 +156,7 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 	// Per cell, the band mean +- k*std; cells whose samples all lie in it (or
 	// that are too small for the rule) are merged as they are; the others are
 	// flagged with their band and re-accumulated without their outliers.
-	size_t flagged = 0;
+	size_t flagged = 0, flaggedCount = 0;
 	for (uint32_t c : m_frameTouched)
 	{
 		FrameCell& a = m_frame[c];
@@ -170,6 +170,7 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 		m_filterMean[c] = mean;
 		m_filterLimit[c] = lim;
 		m_flagged[c] = 1;
+		flaggedCount += a.count;
 		a = FrameCell{};
 		flagged++;
 	}
@@ -178,8 +179,13 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 	{
 		// Pass 2, only if some cell had outliers: re-accumulate the flagged
 		// cells (a byte per cell tells which: it stays in the L1 cache).
-		// (Four quarters of the list in lockstep, as pass 1.)
-		const size_t listed = samplesInMarkedCells(pts, m_flagged.data(), m_flaggedSamples);
+		// (Four quarters of the list in lockstep, as pass 1.) Where their
+		// samples are under 1/8 of the frame's, most blocks of 16 samples
+		// hold none: they are skipped (listing a Kinect One frame whose
+		// flagged cells hold 2 % of its samples, 78 -> 55 us; a Femto or
+		// D435 frame's hold 25-30 %, where skipping costs 25 %).
+		const bool fewFlagged = 8 * flaggedCount < n;
+		const size_t listed = samplesInMarkedCells(pts, m_flagged.data(), m_flaggedSamples, fewFlagged);
 		const auto readd = [&](size_t k) {
 			const uint32_t i = m_flaggedSamples[k];
 			const uint32_t c = cellOf[i];
