@@ -202,8 +202,15 @@ VoxelClass InverseSensorModel::classify(
 	// d_pth part (plane error, floor unevenness) does not.
 	if (m_params.mean_test && c.count > 1 && th > m_params.d_pth)
 	{
+		// The band below is never narrower than d_pth, nor, with the measured
+		// floor offset, than min(d_pth, traversable_step): a mean within that
+		// is ground without its square roots (most floor cells; the same
+		// class, the bound is exact).
+		const bool measuredOffset = floorOffset >= 0 && m_params.noise_sigmas > 0;
+		const double narrowest = measuredOffset ? std::min(m_params.d_pth, m_params.traversable_step) : m_params.d_pth;
+		if (std::abs(dMean) <= narrowest) return VoxelClass::Ground;
 		double meanBand = m_params.d_pth + (th - m_params.d_pth) / std::sqrt(double(c.count));
-		if (floorOffset >= 0 && m_params.noise_sigmas > 0)
+		if (measuredOffset)
 		{
 			// Both parts measured on this frame's floor: sigma (one sample) from
 			// the band, tau (a cell's mean) from the floor cells. Never wider
