@@ -1,7 +1,8 @@
 // Per-stage and whole-pipeline timings of the ground-aware grid, and the two
 // comparison maps on the same frames, with Google Benchmark (Release build).
 //
-//   gam-bench [--frames=N] [--decimation=N] [--full-octomap=M] FILE.rawlog [FILE.rawlog ...] [benchmark flags]
+//   gam-bench [--frames=N] [--decimation=N] [--full-octomap=M] [--no-summary] FILE.rawlog [FILE.rawlog ...]
+//             [benchmark flags]
 //
 // Each rawlog's 3D frames (up to N, default 20) are loaded once; every case
 // cycles through them. After the cases, a summary prints median and p95 ms
@@ -9,7 +10,8 @@
 // frames, and the ratios; then the ground-aware grid's stages (median / p95);
 // where height_band's time goes (MRPT's convertTo2DScan, the scan's insertion)
 // next to the same band as a plain loop; with --full-octomap=M, also the
-// octomap fed every pixel (first M frames).
+// octomap fed every pixel (first M frames). --no-summary: the cases only (a
+// profile of the default alone, e.g. under callgrind; before/after stage timings).
 #include <benchmark/benchmark.h>
 #include <gam/core/CameraNoise.h>
 #include <gam/maps/ObservationAdapters.h>
@@ -276,6 +278,7 @@ int main(int argc, char** argv)
 	size_t maxFrames = 20;
 	int decimation = 1;  // > 1: also the default with every n-th pixel row and column
 	int fullOctomapFrames = 0;
+	bool summary = true;
 	std::vector<std::string> files;
 	std::vector<char*> bargs{argv[0]};
 	for (int i = 1; i < argc; i++)
@@ -286,6 +289,8 @@ int main(int argc, char** argv)
 			decimation = std::max(1, std::atoi(argv[i] + 13));
 		else if (std::strncmp(argv[i], "--full-octomap=", 15) == 0)
 			fullOctomapFrames = std::max(0, std::atoi(argv[i] + 15));
+		else if (std::strcmp(argv[i], "--no-summary") == 0)
+			summary = false;
 		else if (std::strncmp(argv[i], "--", 2) == 0)
 			bargs.push_back(argv[i]);
 		else
@@ -293,8 +298,8 @@ int main(int argc, char** argv)
 	}
 	if (files.empty())
 	{
-		std::cerr << "usage: gam-bench [--frames=N] [--decimation=N] [--full-octomap=M] FILE.rawlog [...] [benchmark "
-					 "flags]\n";
+		std::cerr << "usage: gam-bench [--frames=N] [--decimation=N] [--full-octomap=M] [--no-summary] FILE.rawlog "
+					 "[...] [benchmark flags]\n";
 		return 2;
 	}
 	try
@@ -327,6 +332,7 @@ int main(int argc, char** argv)
 	benchmark::Initialize(&bargc, bargs.data());
 	benchmark::RunSpecifiedBenchmarks();
 	benchmark::Shutdown();
+	if (!summary) return 0;
 
 	// Each map once over the same frames; the ground-aware run also records its
 	// stages, and so does the same grid in paper mode (ism_model = rrt_variant = paper).
