@@ -11,6 +11,7 @@
 #include <random>
 
 #include "gam/core/InverseSensorModel.h"
+#include "gam/core/PatchMemory.h"
 #include "gam/core/RrtGroundDetector.h"
 #include "test_helpers.h"
 
@@ -446,4 +447,128 @@ TEST(Ramps, FlatFloorAddsNoFilledNodes)
 	bare.detect(grid, {0, 0, 0}, ref);
 	ASSERT_EQ(ref.nodes.size(), out.nodes.size());
 	EXPECT_EQ(ref.plane().d, out.plane().d);
+}
+
+TEST(Ramps, ASliverOfARampEarlierFramesFittedIsJudgedAgainstTheirPatch)
+{
+	// Two frames see the whole ramp and fit its patch; a third sees only a
+	// sliver of it: the way up along its side, y in [0.2, 0.35), x in
+	// [1.5, 2.2) (the ramp at the side edge of the view, as the D435 sees
+	// office_traverse's). Three columns of cells: too narrow for a patch of
+	// its own, so that frame's ground is the floor plane alone, against
+	// which the sliver stands tan 8 deg * (1.5 - 1.0) = 0.070 m to
+	// tan 8 deg * 1.2 = 0.169 m high: obstacles, far beyond the band (d_pth
+	// 3 cm + 3 sigma of the 2 mm noise). Judged also against the patch the
+	// earlier frames fitted (patch_memory), the sliver is ramp: free.
+	ElevationGrid whole;
+	buildRampScene(whole, false);
+	const GroundDetection seen = detectFromOrigin(whole);
+	ASSERT_TRUE(seen.ok());
+	ASSERT_GE(seen.planes.size(), 2u) << seen.describe();
+	const double band = seen.patch_inlier_distance, reach = IsmParams{}.plane_support_radius;
+	PatchMemory memory;
+	memory.apply(seen, 0.0, 1.0, band, reach, IsmParams{}.traversable_step);  // the first frame that fits it
+	memory.apply(seen, 0.1, 1.0, band, reach, IsmParams{}.traversable_step);  // the second
+
+	auto inSliver = [](double x, double y) { return x >= 1.5 && x < 2.2 && y >= 0.2 && y < kHalfWidth; };
+	ElevationGrid grid;
+	std::mt19937 rng(17);
+	sampleIntoGrid(
+		grid,
+		[&](double x, double y) { return inRect(x, y, -1.0, 4.5, -2.5, 2.5) && (!onRamp(x, y) || inSliver(x, y)); },
+		rampZ, 0.002, rng);
+	const GroundDetection sliver = detectFromOrigin(grid);
+	ASSERT_TRUE(sliver.ok()) << sliver.describe();
+	ASSERT_EQ(sliver.planes.size(), 1u) << "the sliver got a patch of its own: " << sliver.describe();
+
+	auto obstacleCells = [&](const GroundDetection& det) {
+		InverseSensorModel ism;
+		IsmStats st;
+		ism.compute(grid, det, kSensor, 5.0, st);
+		const GridGeometry& g = grid.geometry();
+		size_t cells = 0, obstacle = 0;
+		for (uint32_t idx : grid.observedCells())
+		{
+			const double x = g.cx(int(idx % uint32_t(g.nx))), y = g.cy(int(idx / uint32_t(g.nx)));
+			// Off the ramp's side (the cell at y in [0.3, 0.35) holds its edge).
+			if (!inSliver(x, y) || y >= kHalfWidth - 0.05) continue;
+			cells++;
+			obstacle += ism.evidence()[idx] > 0.5f;
+		}
+		return std::make_pair(cells, obstacle);
+	};
+	// 14 x 2 cells: x in [1.5, 2.2) by 5 cm, y in [0.2, 0.3).
+	const auto [cells, alone] = obstacleCells(sliver);
+	ASSERT_EQ(cells, 28u);
+	EXPECT_EQ(alone, cells) << "against the floor alone every sliver cell is an obstacle";
+	const GroundDetection& judged = memory.apply(sliver, 0.2, 1.0, band, reach, IsmParams{}.traversable_step);
+	// The way up and the way down; the landing is level (PatchMemory::sloped).
+	ASSERT_EQ(seen.planes.size(), 4u) << seen.describe();
+	EXPECT_EQ(memory.applied(), 2u);
+	EXPECT_EQ(judged.remembered_from, 1u);
+	const auto [cells2, remembered] = obstacleCells(judged);
+	EXPECT_EQ(cells2, cells);
+	EXPECT_EQ(remembered, 0u);
+}
+
+TEST(Ramps, ARememberedPatchDoesNotJudgeWhereTheFramesOwnPatchApplies)
+{
+	// The ramp with its cable protector, whose frame fits the ramp's patch
+	// itself. Earlier frames (twice) fitted a wrong patch: the ramp's plane
+	// 4 cm higher, on nodes around the cable, the plane of the cable's top.
+	// Offered beside the frame's planes everywhere, it would hold the cable's
+	// cells (each voxel is judged against the plane it fits best): where the
+	// frame's own patch applies, it is not offered, and the cable stays an
+	// obstacle as without any memory (CableProtectorOnTheRampIsStillAnObstacle).
+	ElevationGrid grid;
+	buildRampScene(grid, true);
+	const GroundDetection out = detectFromOrigin(grid);
+	ASSERT_TRUE(out.ok()) << out.describe();
+	ASSERT_GE(out.planes.size(), 2u) << out.describe();
+
+	// z = tan 8 deg (x - 1) + 0.04: tan8 x - z + (0.04 - tan8) = 0, normalised.
+	const double n = std::sqrt(1.0 + kTan8 * kTan8);
+	const Plane cableTop{-kTan8 / n, 0, 1 / n, (kTan8 - kCableH) / n};
+	EXPECT_NEAR(cableTop.heightAt(1.54, 0.0), kTan8 * 0.54 + kCableH, 1e-9);
+	GroundDetection wrong;
+	wrong.status = GroundDetection::Status::Ok;
+	wrong.planes = {out.planes[0], cableTop};
+	wrong.plane_support = {1, 9};
+	for (double x : {1.45, 1.55, 1.65})
+		for (double y : {-0.2, 0.0, 0.2})
+		{
+			GroundNode g;
+			g.x = float(x);
+			g.y = float(y);
+			g.z = float(cableTop.heightAt(x, y));
+			g.plane_id = 1;
+			wrong.nodes.push_back(g);
+		}
+	const double band = out.patch_inlier_distance, reach = IsmParams{}.plane_support_radius;
+	PatchMemory memory;
+	memory.apply(wrong, 0.0, 1.0, band, reach, IsmParams{}.traversable_step);
+	memory.apply(wrong, 0.1, 1.0, band, reach, IsmParams{}.traversable_step);
+	const GroundDetection& judged = memory.apply(out, 0.2, 1.0, band, reach, IsmParams{}.traversable_step);
+	ASSERT_EQ(memory.applied(), 1u) << "the cable's plane is 4 cm from the ramp's: not the same surface";
+
+	auto cableObstacles = [&](const GroundDetection& det) {
+		InverseSensorModel ism;
+		IsmStats st;
+		ism.compute(grid, det, kSensor, 5.0, st);
+		return classifyRamp(grid, ism);
+	};
+	const RampCells own = cableObstacles(out), withMemory = cableObstacles(judged);
+	EXPECT_EQ(withMemory.cableObstacle, own.cableObstacle);
+	EXPECT_GE(double(withMemory.cableObstacle), 0.9 * double(withMemory.cable));
+	EXPECT_EQ(withMemory.rampObstacle, 0u);
+	// Offered beside the frame's planes everywhere (the same planes, every
+	// remembered node counted as the frame's own), it frees the cable's
+	// cells whose samples all lie within its band (measured: 14 of 28 stay
+	// obstacles, the row that is only partly cable).
+	GroundDetection everywhere = judged;
+	everywhere.remembered_from = 0;
+	const size_t freed = cableObstacles(everywhere).cableObstacle;
+	std::cout << "cable obstacle cells: own planes " << own.cableObstacle << ", with memory "
+			  << withMemory.cableObstacle << ", memory everywhere " << freed << std::endl;
+	EXPECT_LT(double(freed), 0.7 * double(own.cableObstacle));
 }

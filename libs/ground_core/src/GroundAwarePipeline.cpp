@@ -76,8 +76,16 @@ void GroundAwarePipeline::resetResult()
 	m_result.missing = MissingFloorStats{};
 	m_result.camera = CameraModel::Custom;
 	m_result.trust_range = std::numeric_limits<double>::infinity();
+	m_result.remembered_patches = 0;
 	m_missing.clear();
 	m_result.ms = StageTimes{};
+}
+
+void GroundAwarePipeline::forgetPatches()
+{
+	m_patchMemory.clear();
+	m_travelled = 0;
+	m_haveLastRobot = false;
 }
 
 Eigen::Vector2d GroundAwarePipeline::gridOrigin(const Eigen::Vector3d& robot, const GridLattice& lattice) const
@@ -175,6 +183,16 @@ const FrameResult& GroundAwarePipeline::process(
 		det.planes[0] = Plane{0, 0, 1, -robot.z()};
 		det.ground_from_mount = true;
 	}
+	// The ramp patches of this camera's earlier frames (in the map frame),
+	// offered to the ISM beside this frame's planes (see PatchMemory).
+	if (m_haveLastRobot) m_travelled += (robot.head<2>() - m_lastRobot.head<2>()).norm();
+	m_lastRobot = robot;
+	m_haveLastRobot = true;
+	const bool memory = !paperIsm && m_params.rrt.variant != MethodVariant::Paper && m_params.ism.local_planes;
+	const GroundDetection& judged = m_patchMemory.apply(
+		det, m_travelled, memory ? m_params.patch_memory : 0.0, det.patch_inlier_distance,
+		m_params.ism.plane_support_radius, m_params.ism.traversable_step);
+	m_result.remembered_patches = m_patchMemory.applied();
 	const auto t3 = clk::now();
 
 	// 3. Evidence, within the range of trust of the camera.
@@ -186,7 +204,7 @@ const FrameResult& GroundAwarePipeline::process(
 		frame.has_image && frame.image.is_depth ? Eigen::Vector3d(frame.sensor_to_map.R.cast<double>().col(0))
 												: Eigen::Vector3d::Zero(),
 		sampleRangeLimit(frame, filter));
-	m_ism.compute(m_grid, m_result.detection, m_result.sensor, evidenceRange, m_result.ism, &m_bins);
+	m_ism.compute(m_grid, judged, m_result.sensor, evidenceRange, m_result.ism, &m_bins);
 	const auto t4 = clk::now();
 
 	// 4. Missing floor: where the ground predicts a floor return and the

@@ -245,14 +245,22 @@ void InverseSensorModel::buildSupport(const GridGeometry& g, const GroundDetecti
 	if (!m_params.local_planes || det.planes.size() < 2) return;
 	const double bres = B * g.resolution;
 	const int rb = int(std::ceil(m_params.plane_support_radius / bres));
-	for (const GroundNode& n : det.nodes)
-	{
-		if (n.plane_id < 1) continue;
-		const int bx = int(std::floor((n.x - g.x_min) / bres)), by = int(std::floor((n.y - g.y_min) / bres));
-		for (int yy = std::max(0, by - rb); yy <= std::min(m_bny - 1, by + rb); yy++)
-			for (int xx = std::max(0, bx - rb); xx <= std::min(m_bnx - 1, bx + rb); xx++)
-				m_support[size_t(yy) * size_t(m_bnx) + size_t(xx)] |= uint8_t(1u << n.plane_id);
-	}
+	// This frame's patches, then the remembered ones (PatchMemory) where none
+	// of this frame's applies: what the frame fitted itself decides there.
+	const int firstRemembered = det.remembered_from > 0 ? int(det.remembered_from) : int(det.planes.size());
+	const uint8_t own = uint8_t(((1u << firstRemembered) - 1u) & ~1u);
+	for (int pass = 0; pass < 2; pass++)
+		for (const GroundNode& n : det.nodes)
+		{
+			if (n.plane_id < 1 || (n.plane_id >= firstRemembered) != (pass == 1)) continue;
+			const int bx = int(std::floor((n.x - g.x_min) / bres)), by = int(std::floor((n.y - g.y_min) / bres));
+			for (int yy = std::max(0, by - rb); yy <= std::min(m_bny - 1, by + rb); yy++)
+				for (int xx = std::max(0, bx - rb); xx <= std::min(m_bnx - 1, bx + rb); xx++)
+				{
+					uint8_t& bits = m_support[size_t(yy) * size_t(m_bnx) + size_t(xx)];
+					if (pass == 0 || !(bits & own)) bits |= uint8_t(1u << n.plane_id);
+				}
+		}
 }
 
 const Plane& InverseSensorModel::choosePlane(

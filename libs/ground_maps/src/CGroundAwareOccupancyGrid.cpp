@@ -251,6 +251,8 @@ void CGroundAwareOccupancyGrid::resetRunState()
 	m_missingLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
 	m_scanOnlyLayer.setSize(getXMin(), getXMax(), getYMin(), getYMax(), getResolution(), 0.5f);
 	m_positiveSeen.clear();
+	// A new map: no ramp patch of the last run's frames judges the next ones.
+	for (auto& [label, pipeline] : m_pipelines) pipeline.forgetPatches();
 	m_depthFrames = 0;
 	m_scansBeforeDepth = 0;
 	m_warnedNoFreeSpace = false;

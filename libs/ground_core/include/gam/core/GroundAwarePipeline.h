@@ -17,6 +17,7 @@
 #include "gam/core/InverseSensorModel.h"
 #include "gam/core/MissingFloor.h"
 #include "gam/core/Parameters.h"
+#include "gam/core/PatchMemory.h"
 #include "gam/core/RrtGroundDetector.h"
 #include "gam/core/SensorFrame.h"
 
@@ -55,6 +56,13 @@ struct PipelineParams
 	 * 2 m ahead: 5 cm) and a floor's unevenness explain. 0 = off; not in the
 	 * paper's model. [m] */
 	double max_ground_offset = 0.10;
+	/** Ramp patches of this camera's earlier frames judge this frame's voxels
+	 * too (see PatchMemory): a patch is forgotten once the robot has travelled
+	 * this far since a frame last fitted it. 1.0 m: at an odometry drift of
+	 * 2 % of the distance (the simulator's) the patch has moved 2 cm, which
+	 * on an 8 deg ramp is 2.8 mm of height, under a tenth of d_pth. 0 = off;
+	 * not in the paper's model. [m] */
+	double patch_memory = 1.0;
 
 	template <class Self, class Visit>
 	static void forEachParam(Self& p, Visit&& visit)
@@ -76,6 +84,12 @@ struct PipelineParams
 				"a ground plane this far from the robot's floor under the robot is replaced by that floor [m]; 0 = "
 				"off"},
 			p.max_ground_offset);
+		visit(
+			ParamInfo{
+				"patch_memory", 0, 1000,
+				"ramp patches of earlier frames judge this frame until the robot has travelled this far [m]; 0 = "
+				"off"},
+			p.patch_memory);
 	}
 	/** Every range and every rule between parameters; throws
 	 * std::invalid_argument naming the key. */
@@ -123,6 +137,9 @@ struct FrameResult
 	 * (paper mode, a frame without intrinsics). [m] */
 	CameraModel camera = CameraModel::Custom;
 	double trust_range = std::numeric_limits<double>::infinity();
+	/** Ramp patches of earlier frames that judged this frame's voxels beside
+	 * detection's planes (patch_memory). */
+	size_t remembered_patches = 0;
 	StageTimes ms;
 };
 
@@ -150,6 +167,9 @@ class GroundAwarePipeline
 
 	/** Forgets the last frame (result().valid = false); buffers are kept. */
 	void resetResult();
+	/** Forgets the ramp patches of earlier frames (patch_memory) and the path
+	 * travelled: a new map or run. */
+	void forgetPatches();
 
 	const FrameResult& result() const { return m_result; }
 	/** The 2.5D map of the last frame. */
@@ -171,6 +191,10 @@ class GroundAwarePipeline
 	RrtGroundDetector m_rrt;
 	InverseSensorModel m_ism;
 	MissingFloorDetector m_missing;
+	PatchMemory m_patchMemory;
+	double m_travelled = 0;  ///< the robot's path length over the frames [m]
+	Eigen::Vector3d m_lastRobot = Eigen::Vector3d::Zero();
+	bool m_haveLastRobot = false;
 	FrameResult m_result;
 };
 

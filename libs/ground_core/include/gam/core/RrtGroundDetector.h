@@ -170,6 +170,9 @@ struct GroundDetection
 	 * farther from the robot's floor than max_ground_offset (the pipeline). */
 	bool ground_from_mount = false;
 	Plane tree_plane;  ///< the tree's plane when ground_from_mount (the mount check measures it)
+	/** planes[remembered_from..] are patches of earlier frames (PatchMemory),
+	 * which apply only where none of this frame's patches does; 0 = none. */
+	size_t remembered_from = 0;
 
 	bool ok() const { return status == Status::Ok; }
 	const Plane& plane() const { return planes.front(); }
@@ -185,6 +188,7 @@ struct GroundDetection
 		patch_inlier_distance = 0;
 		iterations = 0;
 		ground_from_mount = false;
+		remembered_from = 0;
 	}
 	static const char* statusName(Status s);
 	std::string describe() const;
