@@ -186,3 +186,24 @@ TEST(PatchMemory, OnlyAPatchWhoseNodesMeasureASlopeIsRemembered)
 	const GroundDetection without = frame(false);
 	EXPECT_EQ(&m.apply(without, 0.2, kForget, kBand, kReach, kRise), &without);
 }
+
+TEST(PatchMemory, RestoreUndoesTheFramesSinceSave)
+{
+	// A frame run twice (ahead on a worker, then again in its turn) counts
+	// once: after restore() the second fit of the ramp never happened, so
+	// it has one frame, too few to judge the next frame.
+	PatchMemory m;
+	const GroundDetection withRamp = frame(true), without = frame(false);
+	m.apply(withRamp, 0.0, kForget, kBand, kReach, kRise);
+	m.save();
+	m.apply(withRamp, 0.1, kForget, kBand, kReach, kRise);  // the run not taken
+	m.restore();
+	EXPECT_EQ(&m.apply(without, 0.1, kForget, kBand, kReach, kRise), &without);
+	EXPECT_EQ(m.applied(), 0u);
+	// Without the restore it would have judged it.
+	PatchMemory m2;
+	m2.apply(withRamp, 0.0, kForget, kBand, kReach, kRise);
+	m2.apply(withRamp, 0.1, kForget, kBand, kReach, kRise);
+	m2.apply(without, 0.1, kForget, kBand, kReach, kRise);
+	EXPECT_EQ(m2.applied(), 1u);
+}

@@ -165,6 +165,45 @@ TEST(ParallelCameras, TwoCamerasThreads2IsByteIdenticalToOneByOne)
 	}
 }
 
+TEST(ParallelCameras, RampPatchesRememberedPerCameraStayByteIdentical)
+{
+	// Each camera's pipeline remembers the ramp patches its frames fitted
+	// (patch_memory): a frame that ran ahead and runs again must count once.
+	// A 7 deg ramp beside the walk, as steps of 1 cm every 8 cm (under d_pth
+	// and traversable_step: the tree fits it as one sloped patch), 0.9 m wide.
+	auto scene = corridorScene();
+	for (int k = 0; k < 14; k++) scene.push_back({2.0 + 0.08 * k, -1.6, 0.0, 3.6, -0.7, 0.01 * (k + 1)});
+	const CPose3D forward(0.10, 0, 0.80, 0, DEG2RAD(25.0), 0);
+	const CPose3D down(0.05, 0, 0.60, 0, DEG2RAD(60.0), 0);
+	std::vector<PoseFrames> poses;
+	for (int i = 0; i < 8; i++)
+	{
+		const double t = 100.0 + 0.1 * i;
+		PoseFrames p;
+		p.robot = CPose3D(0.2 * i, 0.02 * i, 0, DEG2RAD(i % 2 ? 4.0 : -3.0), 0, 0);
+		p.frames.push_back(camera(scene, p.robot, forward, "KINECT", t));
+		p.frames.push_back(camera(scene, p.robot, down, "KINECT_DOWN", t));
+		poses.push_back(p);
+	}
+	CGroundAwareOccupancyGrid oneByOne = makeGrid(1, false), batch2 = makeGrid(2, false);
+	size_t remembered = 0;
+	for (const PoseFrames& p : poses)
+	{
+		for (const auto& o : p.frames)
+		{
+			oneByOne.insertObservation(*o, p.robot);
+			remembered += oneByOne.lastFrame().remembered_patches;
+		}
+		EXPECT_TRUE(batch2.insertObservations(pointers(p), p.robot));
+	}
+	std::cout << "[parallel] ramp: " << remembered << " remembered patches applied one by one; threads=2 "
+			  << batch2.parallelStats().ran_ahead << " ran ahead, " << batch2.parallelStats().run_again
+			  << " run again\n";
+	EXPECT_GT(remembered, 0u) << "the walk must exercise the memory";
+	EXPECT_GE(batch2.parallelStats().run_again, 1u);
+	expectSameGrid(oneByOne, batch2, "ramp, threads=2");
+}
+
 TEST(ParallelCameras, SameLabelTwiceAndAfterEachSeeEveryFrameInOrder)
 {
 	// Two frames of one camera in a set: the second needs the first's mount

@@ -84,8 +84,17 @@ void GroundAwarePipeline::resetResult()
 void GroundAwarePipeline::forgetPatches()
 {
 	m_patchMemory.clear();
-	m_travelled = 0;
-	m_haveLastRobot = false;
+	m_patchMemory.save();
+	m_travelled = m_travelledBefore = 0;
+	m_haveLastRobot = m_haveLastRobotBefore = false;
+}
+
+void GroundAwarePipeline::rewindPatches()
+{
+	m_patchMemory.restore();
+	m_travelled = m_travelledBefore;
+	m_lastRobot = m_lastRobotBefore;
+	m_haveLastRobot = m_haveLastRobotBefore;
 }
 
 Eigen::Vector2d GroundAwarePipeline::gridOrigin(const Eigen::Vector3d& robot, const GridLattice& lattice) const
@@ -185,6 +194,10 @@ const FrameResult& GroundAwarePipeline::process(
 	}
 	// The ramp patches of this camera's earlier frames (in the map frame),
 	// offered to the ISM beside this frame's planes (see PatchMemory).
+	m_patchMemory.save();
+	m_travelledBefore = m_travelled;
+	m_lastRobotBefore = m_lastRobot;
+	m_haveLastRobotBefore = m_haveLastRobot;
 	if (m_haveLastRobot) m_travelled += (robot.head<2>() - m_lastRobot.head<2>()).norm();
 	m_lastRobot = robot;
 	m_haveLastRobot = true;

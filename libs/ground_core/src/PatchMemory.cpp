@@ -12,13 +12,27 @@ PatchMemory::PatchMemory()
 	// Room for the most the memory ever holds: no allocation per frame.
 	m_patches.reserve(kMaxPlanes);
 	m_next.reserve(kMaxPlanes);
+	m_savedPatches.reserve(kMaxPlanes);
 	m_nodes.reserve(kMaxPlanes * kMaxNodesPerPatch);
 	m_nextNodes.reserve(kMaxPlanes * kMaxNodesPerPatch);
+	m_savedNodes.reserve(kMaxPlanes * kMaxNodesPerPatch);
 	m_keep.reserve(kMaxPlanes);
 	m_frames.reserve(kMaxPlanes);
 	m_augmented.planes.reserve(kMaxPlanes);
 	m_augmented.plane_support.reserve(kMaxPlanes);
 	m_augmented.nodes.reserve(kMaxPlanes * kMaxNodesPerPatch);
+}
+
+void PatchMemory::save()
+{
+	m_savedPatches = m_patches;
+	m_savedNodes = m_nodes;
+}
+
+void PatchMemory::restore()
+{
+	m_patches = m_savedPatches;
+	m_nodes = m_savedNodes;
 }
 
 void PatchMemory::clear()

@@ -681,7 +681,12 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 			if (slot.ran && slot.prepared.sameInputs(prep))
 				ahead = &slot;
 			else
+			{
+				// Its first run counts for nothing: not for the ramp patches
+				// its pipeline remembers either.
+				if (slot.ran) pipeline.rewindPatches();
 				m_parallelStats.run_again++;
+			}
 			break;
 		}
 	if (ahead)

@@ -170,6 +170,11 @@ class GroundAwarePipeline
 	/** Forgets the ramp patches of earlier frames (patch_memory) and the path
 	 * travelled: a new map or run. */
 	void forgetPatches();
+	/** Undoes what the last process() did to the ramp patches remembered and
+	 * the path travelled, before running a frame again whose first run is
+	 * not taken (its inputs changed meanwhile): the frame then counts once,
+	 * as without threads. */
+	void rewindPatches();
 
 	const FrameResult& result() const { return m_result; }
 	/** The 2.5D map of the last frame. */
@@ -195,6 +200,10 @@ class GroundAwarePipeline
 	double m_travelled = 0;  ///< the robot's path length over the frames [m]
 	Eigen::Vector3d m_lastRobot = Eigen::Vector3d::Zero();
 	bool m_haveLastRobot = false;
+	// The three before the last process() (rewindPatches()).
+	double m_travelledBefore = 0;
+	Eigen::Vector3d m_lastRobotBefore = Eigen::Vector3d::Zero();
+	bool m_haveLastRobotBefore = false;
 	FrameResult m_result;
 };
 

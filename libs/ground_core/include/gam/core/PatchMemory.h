@@ -50,6 +50,12 @@ class PatchMemory
 	const GroundDetection& apply(
 		const GroundDetection& det, double travelled, double forgetAfter, double band, double reach, double rise);
 
+	/** Keeps the memory as it is now; restore() brings it back (a frame that
+	 * ran ahead on inputs that changed runs again: CGroundAwareOccupancyGrid
+	 * with threads > 1). No allocation once warm. */
+	void save();
+	void restore();
+
 	/** Patches remembered after the last apply(). */
 	size_t size() const { return m_patches.size(); }
 	/** Of the last apply(): remembered patches appended to the frame's. */
@@ -79,8 +85,8 @@ class PatchMemory
 	struct Patch
 	{
 		Plane plane;
-		double seen_at = 0;  ///< path length when a frame last fitted it [m]
-		int frames = 1;      ///< frames that fitted it, each repeating the last
+		double seen_at = 0;           ///< path length when a frame last fitted it [m]
+		int frames = 1;               ///< frames that fitted it, each repeating the last
 		uint32_t begin = 0, end = 0;  ///< its nodes in m_nodes
 	};
 	/** The patch of this frame that is the same surface as `p`, 0 if none. */
@@ -88,6 +94,8 @@ class PatchMemory
 
 	std::vector<Patch> m_patches, m_next;
 	std::vector<Eigen::Vector2f> m_nodes, m_nextNodes;
+	std::vector<Patch> m_savedPatches;
+	std::vector<Eigen::Vector2f> m_savedNodes;
 	std::vector<uint8_t> m_keep;
 	std::vector<int> m_frames;  ///< per plane of this frame
 	GroundDetection m_augmented;
