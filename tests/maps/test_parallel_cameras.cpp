@@ -48,11 +48,12 @@ Obs camera(const std::vector<Box>& scene, const CPose3D& robot, const CPose3D& m
 	return o;
 }
 
-// A walk along x with turns: the grid (created small) grows on the way,
+// A walk along x with turns (8 poses, `step` apart along x, yawed by
+// `yawOdd` / `yawEven` deg): the grid (created small) grows on the way,
 // sometimes between the two frames of one pose.
-std::vector<PoseFrames> walk()
+std::vector<PoseFrames> walk(
+	const std::vector<Box>& scene = corridorScene(), double step = 0.9, double yawOdd = 8.0, double yawEven = -5.0)
 {
-	const auto scene = corridorScene();
 	const CPose3D forward(0.10, 0, 0.80, 0, DEG2RAD(25.0), 0);
 	const CPose3D down(0.05, 0, 0.60, 0, DEG2RAD(60.0), 0);
 	std::vector<PoseFrames> out;
@@ -60,7 +61,7 @@ std::vector<PoseFrames> walk()
 	{
 		const double t = 100.0 + 0.1 * i;
 		PoseFrames p;
-		p.robot = CPose3D(0.9 * i, 0.05 * i, 0, DEG2RAD(i % 2 ? 8.0 : -5.0), 0, 0);
+		p.robot = CPose3D(step * i, step / 18.0 * i, 0, DEG2RAD(i % 2 ? yawOdd : yawEven), 0, 0);
 		p.frames.push_back(camera(scene, p.robot, forward, "KINECT", t));
 		p.frames.push_back(camera(scene, p.robot, down, "KINECT_DOWN", t));
 		out.push_back(p);
@@ -173,18 +174,7 @@ TEST(ParallelCameras, RampPatchesRememberedPerCameraStayByteIdentical)
 	// and traversable_step: the tree fits it as one sloped patch), 0.9 m wide.
 	auto scene = corridorScene();
 	for (int k = 0; k < 14; k++) scene.push_back({2.0 + 0.08 * k, -1.6, 0.0, 3.6, -0.7, 0.01 * (k + 1)});
-	const CPose3D forward(0.10, 0, 0.80, 0, DEG2RAD(25.0), 0);
-	const CPose3D down(0.05, 0, 0.60, 0, DEG2RAD(60.0), 0);
-	std::vector<PoseFrames> poses;
-	for (int i = 0; i < 8; i++)
-	{
-		const double t = 100.0 + 0.1 * i;
-		PoseFrames p;
-		p.robot = CPose3D(0.2 * i, 0.02 * i, 0, DEG2RAD(i % 2 ? 4.0 : -3.0), 0, 0);
-		p.frames.push_back(camera(scene, p.robot, forward, "KINECT", t));
-		p.frames.push_back(camera(scene, p.robot, down, "KINECT_DOWN", t));
-		poses.push_back(p);
-	}
+	const auto poses = walk(scene, 0.2, 4.0, -3.0);
 	CGroundAwareOccupancyGrid oneByOne = makeGrid(1, false), batch2 = makeGrid(2, false);
 	size_t remembered = 0;
 	for (const PoseFrames& p : poses)
