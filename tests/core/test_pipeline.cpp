@@ -249,3 +249,44 @@ TEST(Pipeline, AWallJustOutOfTheCamerasRangeLeavesNoObstacleInFrontOfIt)
 	EXPECT_GE(cells, 35u);
 	EXPECT_EQ(occupied, cells);
 }
+
+TEST(Pipeline, RewindPatchesCountsAFrameRunTwiceOnce)
+{
+	// A frame that ran ahead on a worker and must run again in its turn
+	// (CGroundAwareOccupancyGrid, threads > 1) counts once for the ramp
+	// patches the pipeline remembers (patch_memory): rewindPatches() undoes
+	// the first run. A 7.1 deg ramp (steps of 1 cm every 8 cm, under d_pth)
+	// ahead of the camera is fitted as a patch in each run of frame A; a
+	// patch is remembered once 2 frames fitted it. Frame B (the floor alone)
+	// then gets it only if frame A counted twice.
+	const PinholeIntrinsics K = gamtest::smallCamera();
+	const Eigen::Vector3d camPos(0, 0, 1.0);
+	const Eigen::Matrix3d R = Eigen::AngleAxisd(deg2rad(25), Eigen::Vector3d::UnitY()).toRotationMatrix();
+	std::vector<Box> ramp;
+	for (int k = 0; k < 14; k++) ramp.push_back({{1.4 + 0.08 * k, -0.5, 0.0}, {2.8, 0.5, 0.01 * (k + 1)}});
+	auto render = [&](const std::vector<Box>& boxes) {
+		return gamtest::renderDepth(K, R, [&](const Eigen::Vector3d& w) {
+			const double t = castRay(camPos, w, 0.0, boxes);
+			return t < 4.5 ? t : -1.0;
+		});
+	};
+	// (A SensorFrame views its depth image: the images outlive the frames.)
+	const std::vector<uint16_t> depthA = render(ramp), depthB = render({});
+	const SensorFrame a = gamtest::depthFrame(depthA, K, R, camPos), b = gamtest::depthFrame(depthB, K, R, camPos);
+	PipelineParams params;
+	params.m_x = params.m_y = 240;
+	const Eigen::Vector3d robot(0, 0, 0);
+	const GridLattice lattice{0, 0, 0.05};
+
+	GroundAwarePipeline once(params), twice(params);
+	const FrameResult& ra = once.process(a, robot, lattice);
+	ASSERT_TRUE(ra.valid);
+	ASSERT_GE(ra.detection.planes.size(), 2u) << "frame A must fit the ramp: " << ra.detection.describe();
+	once.rewindPatches();  // the run not taken
+	once.process(a, robot, lattice);
+	EXPECT_EQ(once.process(b, robot, lattice).remembered_patches, 0u);
+
+	twice.process(a, robot, lattice);
+	twice.process(a, robot, lattice);
+	EXPECT_GE(twice.process(b, robot, lattice).remembered_patches, 1u);
+}
