@@ -81,21 +81,9 @@ void GroundAwarePipeline::resetResult()
 	m_result.ms = StageTimes{};
 }
 
-void GroundAwarePipeline::forgetPatches()
-{
-	m_patchMemory.clear();
-	m_patchMemory.save();
-	m_travelled = m_travelledBefore = 0;
-	m_haveLastRobot = m_haveLastRobotBefore = false;
-}
+void GroundAwarePipeline::forgetPatches() { m_patchMemory.clear(); }
 
-void GroundAwarePipeline::rewindPatches()
-{
-	m_patchMemory.restore();
-	m_travelled = m_travelledBefore;
-	m_lastRobot = m_lastRobotBefore;
-	m_haveLastRobot = m_haveLastRobotBefore;
-}
+void GroundAwarePipeline::rewindPatches() { m_patchMemory.restore(); }
 
 Eigen::Vector2d GroundAwarePipeline::gridOrigin(const Eigen::Vector3d& robot, const GridLattice& lattice) const
 {
@@ -195,15 +183,10 @@ const FrameResult& GroundAwarePipeline::process(
 	// The ramp patches of this camera's earlier frames (in the map frame),
 	// offered to the ISM beside this frame's planes (see PatchMemory).
 	m_patchMemory.save();
-	m_travelledBefore = m_travelled;
-	m_lastRobotBefore = m_lastRobot;
-	m_haveLastRobotBefore = m_haveLastRobot;
-	if (m_haveLastRobot) m_travelled += (robot.head<2>() - m_lastRobot.head<2>()).norm();
-	m_lastRobot = robot;
-	m_haveLastRobot = true;
+	const double travelled = m_patchMemory.advance(robot.head<2>());
 	const bool memory = !paperIsm && m_params.rrt.variant != MethodVariant::Paper && m_params.ism.local_planes;
 	const GroundDetection& judged = m_patchMemory.apply(
-		det, m_travelled, memory ? m_params.patch_memory : 0.0, det.patch_inlier_distance,
+		det, travelled, memory ? m_params.patch_memory : 0.0, det.patch_inlier_distance,
 		m_params.ism.plane_support_radius, m_params.ism.traversable_step);
 	m_result.remembered_patches = m_patchMemory.applied();
 	const auto t3 = clk::now();

@@ -27,19 +27,32 @@ void PatchMemory::save()
 {
 	m_savedPatches = m_patches;
 	m_savedNodes = m_nodes;
+	m_savedPath = m_path;
 }
 
 void PatchMemory::restore()
 {
 	m_patches = m_savedPatches;
 	m_nodes = m_savedNodes;
+	m_path = m_savedPath;
 }
 
 void PatchMemory::clear()
 {
 	m_patches.clear();
 	m_nodes.clear();
+	m_savedPatches.clear();
+	m_savedNodes.clear();
+	m_path = m_savedPath = Path{};
 	m_applied = 0;
+}
+
+double PatchMemory::advance(const Eigen::Vector2d& robot)
+{
+	if (m_path.started) m_path.travelled += (robot - m_path.last).norm();
+	m_path.last = robot;
+	m_path.started = true;
+	return m_path.travelled;
 }
 
 size_t PatchMemory::repeatedBy(const Patch& p, const GroundDetection& det, double band, double reach) const

@@ -197,13 +197,6 @@ class GroundAwarePipeline
 	InverseSensorModel m_ism;
 	MissingFloorDetector m_missing;
 	PatchMemory m_patchMemory;
-	double m_travelled = 0;  ///< the robot's path length over the frames [m]
-	Eigen::Vector3d m_lastRobot = Eigen::Vector3d::Zero();
-	bool m_haveLastRobot = false;
-	// The three before the last process() (rewindPatches()).
-	double m_travelledBefore = 0;
-	Eigen::Vector3d m_lastRobotBefore = Eigen::Vector3d::Zero();
-	bool m_haveLastRobotBefore = false;
 	FrameResult m_result;
 };
 

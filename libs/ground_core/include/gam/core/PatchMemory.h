@@ -27,8 +27,12 @@ class PatchMemory
    public:
 	PatchMemory();
 
-	/** Forgets every patch (a new map, a new run). */
+	/** Forgets every patch and the path travelled (a new map, a new run). */
 	void clear();
+
+	/** The robot's path length over the frames [m], after a frame taken at
+	 * `robot` (map frame, x y): the `travelled` that apply() takes. */
+	double advance(const Eigen::Vector2d& robot);
 
 	/** The detection to judge this frame with, and the memory updated.
 	 * - `det`: this frame's (planes[0] the ground, planes[1..] its patches);
@@ -50,9 +54,9 @@ class PatchMemory
 	const GroundDetection& apply(
 		const GroundDetection& det, double travelled, double forgetAfter, double band, double reach, double rise);
 
-	/** Keeps the memory as it is now; restore() brings it back (a frame that
-	 * ran ahead on inputs that changed runs again: CGroundAwareOccupancyGrid
-	 * with threads > 1). No allocation once warm. */
+	/** Keeps the memory (patches and path) as it is now; restore() brings it
+	 * back (a frame that ran ahead on inputs that changed runs again:
+	 * CGroundAwareOccupancyGrid with threads > 1). No allocation once warm. */
 	void save();
 	void restore();
 
@@ -96,6 +100,14 @@ class PatchMemory
 	std::vector<Eigen::Vector2f> m_nodes, m_nextNodes;
 	std::vector<Patch> m_savedPatches;
 	std::vector<Eigen::Vector2f> m_savedNodes;
+	/** The path: its length, and where the last frame was taken. */
+	struct Path
+	{
+		double travelled = 0;
+		Eigen::Vector2d last = Eigen::Vector2d::Zero();
+		bool started = false;
+	};
+	Path m_path, m_savedPath;
 	std::vector<uint8_t> m_keep;
 	std::vector<int> m_frames;  ///< per plane of this frame
 	GroundDetection m_augmented;
