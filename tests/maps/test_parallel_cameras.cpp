@@ -174,9 +174,15 @@ TEST(ParallelCameras, RampPatchesRememberedPerCameraStayByteIdentical)
 	// and traversable_step: the tree fits it as one sloped patch), 0.9 m wide.
 	auto scene = corridorScene();
 	for (int k = 0; k < 14; k++) scene.push_back({2.0 + 0.08 * k, -1.6, 0.0, 3.6, -0.7, 0.01 * (k + 1)});
-	const auto poses = walk(scene, 0.2, 4.0, -3.0);
+	auto poses = walk(scene, 0.2, 4.0, -3.0);
+	// Two cameras that both see the ramp (the second a little to the right):
+	// the first's evidence grows the grid, so the second's frame, which fits
+	// patches, is the one run again.
+	const CPose3D right(0.10, -0.05, 0.80, DEG2RAD(-6.0), DEG2RAD(25.0), 0);
+	for (PoseFrames& p : poses)
+		p.frames[1] = camera(scene, p.robot, right, "KINECT_RIGHT", mrpt::Clock::toDouble(p.frames[0]->timestamp));
 	CGroundAwareOccupancyGrid oneByOne = makeGrid(1, false), batch2 = makeGrid(2, false);
-	size_t remembered = 0;
+	size_t remembered = 0, fitted = 0;
 	for (const PoseFrames& p : poses)
 	{
 		for (const auto& o : p.frames)
@@ -185,11 +191,29 @@ TEST(ParallelCameras, RampPatchesRememberedPerCameraStayByteIdentical)
 			remembered += oneByOne.lastFrame().remembered_patches;
 		}
 		EXPECT_TRUE(batch2.insertObservations(pointers(p), p.robot));
+		// Each camera's memory as one by one: a frame run twice (its first
+		// run not taken) counted once, its path not walked twice.
+		for (const auto& o : p.frames)
+		{
+			const gam::PatchMemory *a = oneByOne.rememberedPatches(o->sensorLabel),
+								   *b = batch2.rememberedPatches(o->sensorLabel);
+			ASSERT_TRUE(a && b) << o->sensorLabel;
+			EXPECT_EQ(a->travelled(), b->travelled()) << o->sensorLabel;
+			ASSERT_EQ(a->size(), b->size()) << o->sensorLabel;
+			for (size_t k = 0; k < a->size(); k++)
+			{
+				EXPECT_EQ(a->patch(k).frames, b->patch(k).frames) << o->sensorLabel << " patch " << k;
+				EXPECT_EQ(a->patch(k).seen_at, b->patch(k).seen_at) << o->sensorLabel << " patch " << k;
+				EXPECT_EQ(a->patch(k).plane.d, b->patch(k).plane.d) << o->sensorLabel << " patch " << k;
+				fitted += size_t(a->patch(k).frames);
+			}
+		}
 	}
 	std::cout << "[parallel] ramp: " << remembered << " remembered patches applied one by one; threads=2 "
 			  << batch2.parallelStats().ran_ahead << " ran ahead, " << batch2.parallelStats().run_again
 			  << " run again\n";
 	EXPECT_GT(remembered, 0u) << "the walk must exercise the memory";
+	EXPECT_GT(fitted, 0u) << "the memory must hold patches to compare";
 	EXPECT_GE(batch2.parallelStats().run_again, 1u);
 	expectSameGrid(oneByOne, batch2, "ramp, threads=2");
 }

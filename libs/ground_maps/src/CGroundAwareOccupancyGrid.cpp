@@ -607,6 +607,12 @@ gam::GroundAwarePipeline& CGroundAwareOccupancyGrid::pipelineFor(const std::stri
 	return it->second;
 }
 
+const gam::PatchMemory* CGroundAwareOccupancyGrid::rememberedPatches(const std::string& label) const
+{
+	const auto it = m_pipelines.find(label);
+	return it == m_pipelines.end() ? nullptr : &it->second.patchMemory();
+}
+
 const gam::GroundAwarePipeline& CGroundAwareOccupancyGrid::lastPipeline() const
 {
 	if (!m_lastHasPipeline) return m_idlePipeline;

@@ -183,6 +183,8 @@ class GroundAwarePipeline
 	const InverseSensorModel& ism() const { return m_ism; }
 	/** Missing floor of the last frame (frame-grid cells). */
 	const MissingFloorDetector& missingFloor() const { return m_missing; }
+	/** The ramp patches this camera's frames fitted, as remembered now. */
+	const PatchMemory& patchMemory() const { return m_patchMemory; }
 	/** The projector, e.g. to force the baseline row loop in tests. */
 	DepthProjector& projector() { return m_projector; }
 

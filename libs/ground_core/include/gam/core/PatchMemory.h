@@ -62,6 +62,22 @@ class PatchMemory
 
 	/** Patches remembered after the last apply(). */
 	size_t size() const { return m_patches.size(); }
+	/** One remembered patch: its plane (map frame), how many frames fitted
+	 * it (each repeating the last), the path length when one last did. */
+	struct Remembered
+	{
+		Plane plane;
+		int frames = 0;
+		double seen_at = 0;  ///< [m]
+	};
+	/** Patch k of size() (k < size()). */
+	Remembered patch(size_t k) const
+	{
+		const Patch& p = m_patches[k];
+		return {p.plane, p.frames, p.seen_at};
+	}
+	/** The robot's path length over the frames so far [m]. */
+	double travelled() const { return m_path.travelled; }
 	/** Of the last apply(): remembered patches appended to the frame's. */
 	size_t applied() const { return m_applied; }
 

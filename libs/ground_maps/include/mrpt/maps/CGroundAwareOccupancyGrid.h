@@ -216,6 +216,10 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		int width = 0, height_px = 0;
 	};
 	const std::map<std::string, TCameraInfo>& cameras() const { return m_cameras; }
+	/** The ramp patches that the depth frames of sensor `label` fitted, as
+	 * its pipeline remembers them now (patch_memory); null before a depth
+	 * frame of that label. */
+	const gam::PatchMemory* rememberedPatches(const std::string& label) const;
 	/** The label of the last depth frame's sensor (its entry in mountChecks()). */
 	const std::string& lastSensorLabel() const { return m_lastSensorLabel; }
 
