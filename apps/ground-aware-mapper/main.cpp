@@ -84,7 +84,7 @@ int main(int argc, char** argv)
 		TCLAP::CmdLine cmd(
 			"Ground-aware 2D occupancy mapping from a rawlog or live from MRPT sensor drivers (depth cameras, 2D "
 			"scans). Writes, for every 2D grid of the .ini, <label>.yaml/.pgm (ROS map_server), <label>.gridmap.gz "
-			"and <label>.png, plus the elevation map, ground_planes.csv and timing.csv into --out.",
+			"and <label>.png, plus the elevation map, ground_planes.csv, ground_patches.csv and timing.csv into --out.",
 			' ', GAM_VERSION);
 		TCLAP::ValueArg<std::string> aRawlog(
 			"r", "rawlog", "input rawlog (either format)", false, "", "FILE.rawlog", cmd);

@@ -52,7 +52,12 @@ OutlierFilterParams PipelineParams::outlierFilter() const
 	return f;
 }
 
-GroundAwarePipeline::GroundAwarePipeline(const PipelineParams& p) { setParams(p); }
+GroundAwarePipeline::GroundAwarePipeline(const PipelineParams& p)
+{
+	setParams(p);
+	m_result.remembered_planes.reserve(PatchMemory::kMaxPlanes);
+	m_result.remembered_support.reserve(PatchMemory::kMaxPlanes);
+}
 
 void GroundAwarePipeline::setParams(const PipelineParams& p)
 {
@@ -77,6 +82,8 @@ void GroundAwarePipeline::resetResult()
 	m_result.camera = CameraModel::Custom;
 	m_result.trust_range = std::numeric_limits<double>::infinity();
 	m_result.remembered_patches = 0;
+	m_result.remembered_planes.clear();
+	m_result.remembered_support.clear();
 	m_missing.clear();
 	m_result.ms = StageTimes{};
 }
@@ -189,6 +196,14 @@ const FrameResult& GroundAwarePipeline::process(
 		det, travelled, memory ? m_params.patch_memory : 0.0, det.patch_inlier_distance,
 		m_params.ism.plane_support_radius, m_params.ism.traversable_step);
 	m_result.remembered_patches = m_patchMemory.applied();
+	m_result.remembered_planes.clear();
+	m_result.remembered_support.clear();
+	if (&judged != &det && judged.remembered_from > 0)
+		for (size_t k = judged.remembered_from; k < judged.planes.size(); k++)
+		{
+			m_result.remembered_planes.push_back(judged.planes[k]);
+			m_result.remembered_support.push_back(k < judged.plane_support.size() ? judged.plane_support[k] : 0);
+		}
 	const auto t3 = clk::now();
 
 	// 3. Evidence, within the range of trust of the camera.

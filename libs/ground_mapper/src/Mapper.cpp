@@ -206,7 +206,7 @@ struct Mapper::RunState
 	std::chrono::steady_clock::time_point tStart;
 	RunSummary s;
 	TmpDir tmp;
-	std::ofstream timing, planes, snapIndex;
+	std::ofstream timing, planes, patches, snapIndex;
 	std::string snapDir;
 	// Each map's traits (gam/maps/MapRegistry.h); the first map that finds
 	// ground planes writes ground_planes.csv.
@@ -245,10 +245,13 @@ void Mapper::begin()
 
 	r.timing.open(r.tmp.path + "/timing.csv");
 	r.planes.open(r.tmp.path + "/ground_planes.csv");
-	if (!r.timing || !r.planes) throw RunError("cannot write to " + r.tmp.path);
+	r.patches.open(r.tmp.path + "/ground_patches.csv");
+	if (!r.timing || !r.planes || !r.patches) throw RunError("cannot write to " + r.tmp.path);
 	r.timing << "frame,map,stage,ms\n";
 	r.planes << "frame,a,b,c,d,nodes,status,mount_z,mount_pitch_deg,mount_roll_deg,mount_alarm,sensor\n";
 	r.planes << std::setprecision(9);
+	r.patches << "frame,patch,a,b,c,d,nodes,slope_deg,source,sensor\n";
+	r.patches << std::setprecision(9);
 	r.timing << std::fixed << std::setprecision(4);
 	// Snapshots (--snapshot-every N): written into the temporary folder too,
 	// published with the rest.
@@ -321,6 +324,16 @@ void Mapper::recordFrame(size_t i, const Frame& fr, bool is3D, double ms)
 			r.planes << ",,,";
 		// Several cameras: each frame's plane is its own camera's.
 		r.planes << "," << fr.obs->sensorLabel << "\n";
+		// The ramp patches that judged the frame beside the ground: its own,
+		// then those its camera's earlier frames fitted (patch_memory).
+		for (size_t k = 0; k < gp.patches.size(); k++)
+		{
+			const auto& p = gp.patches[k];
+			const double slope = std::atan2(std::hypot(p.a, p.b), std::abs(p.c)) * 180.0 / M_PI;
+			r.patches << fr.index << "," << k + 1 << "," << p.a << "," << p.b << "," << p.c << "," << p.d << ","
+					  << p.nodes << "," << slope << "," << (p.remembered ? "remembered" : "frame") << ","
+					  << fr.obs->sensorLabel << "\n";
+		}
 	}
 }
 
@@ -513,7 +526,9 @@ RunSummary Mapper::end()
 
 	r.timing.close();
 	r.planes.close();
-	if (!r.timing || !r.planes) throw RunError("cannot write timing.csv / ground_planes.csv in " + r.tmp.path);
+	r.patches.close();
+	if (!r.timing || !r.planes || !r.patches)
+		throw RunError("cannot write timing.csv / ground_planes.csv / ground_patches.csv in " + r.tmp.path);
 	if (m_opts.snapshotEvery)
 	{
 		r.snapIndex.close();
@@ -534,6 +549,7 @@ RunSummary Mapper::end()
 	}
 	s.files.push_back("timing.csv");
 	s.files.push_back("ground_planes.csv");
+	s.files.push_back("ground_patches.csv");
 	s.files.push_back("config_used.ini");
 
 	// Publish: move everything into DIR.

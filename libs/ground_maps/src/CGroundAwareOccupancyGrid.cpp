@@ -87,6 +87,17 @@ const bool kTraitsRegistered = [] {
 			r.a = p.a, r.b = p.b, r.c = p.c, r.d = p.d;
 		}
 		r.nodes = det.nodes.size();
+		for (size_t k = 1; det.ok() && k < det.planes.size(); k++)
+		{
+			const gam::Plane& p = det.planes[k];
+			r.patches.push_back({p.a, p.b, p.c, p.d, k < det.plane_support.size() ? det.plane_support[k] : 0, false});
+		}
+		const gam::FrameResult& fr = g.lastFrame();
+		for (size_t k = 0; k < fr.remembered_planes.size(); k++)
+		{
+			const gam::Plane& p = fr.remembered_planes[k];
+			r.patches.push_back({p.a, p.b, p.c, p.d, fr.remembered_support[k], true});
+		}
 		// "mount_floor": the tree's plane was too far from the robot's floor,
 		// the frame was judged against that floor (max_ground_offset).
 		r.status = det.ok() && det.ground_from_mount ? "mount_floor" : gam::GroundDetection::statusName(det.status);

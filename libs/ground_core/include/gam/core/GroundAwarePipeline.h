@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <limits>
+#include <vector>
 
 #include "gam/core/CameraNoise.h"
 #include "gam/core/DepthProjector.h"
@@ -140,6 +141,9 @@ struct FrameResult
 	/** Ramp patches of earlier frames that judged this frame's voxels beside
 	 * detection's planes (patch_memory). */
 	size_t remembered_patches = 0;
+	/** Their planes (map frame) and nodes, in the order the ISM took them. */
+	std::vector<Plane> remembered_planes;
+	std::vector<size_t> remembered_support;
 	StageTimes ms;
 };
 

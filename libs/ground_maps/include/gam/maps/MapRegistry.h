@@ -52,6 +52,15 @@ struct GroundPlaneRecord
 	bool mount_measured = false;
 	double mount_z = 0, mount_pitch_deg = 0, mount_roll_deg = 0;
 	bool mount_alarm = false;
+	/** The frame's ramp patches (the tree's planes after the ground) and the
+	 * patches of earlier frames that judged it too (patch_memory). */
+	struct Patch
+	{
+		double a = 0, b = 0, c = 1, d = 0;  ///< a x + b y + c z + d = 0 (map frame)
+		size_t nodes = 0;
+		bool remembered = false;
+	};
+	std::vector<Patch> patches;
 };
 
 using StageSink = std::function<void(const char* stage, double ms)>;
