@@ -284,9 +284,9 @@ TEST(Pipeline, RewindPatchesCountsAFrameRunTwiceOnce)
 	ASSERT_GE(ra.detection.planes.size(), 2u) << "frame A must fit the ramp: " << ra.detection.describe();
 	once.rewindPatches();  // the run not taken
 	once.process(a, robot, lattice);
-	EXPECT_EQ(once.process(b, robot, lattice).remembered_patches, 0u);
+	EXPECT_EQ(once.process(b, robot, lattice).remembered_planes.size(), 0u);
 
 	twice.process(a, robot, lattice);
 	twice.process(a, robot, lattice);
-	EXPECT_GE(twice.process(b, robot, lattice).remembered_patches, 1u);
+	EXPECT_GE(twice.process(b, robot, lattice).remembered_planes.size(), 1u);
 }

@@ -188,7 +188,7 @@ TEST(ParallelCameras, RampPatchesRememberedPerCameraStayByteIdentical)
 		for (const auto& o : p.frames)
 		{
 			oneByOne.insertObservation(*o, p.robot);
-			remembered += oneByOne.lastFrame().remembered_patches;
+			remembered += oneByOne.lastFrame().remembered_planes.size();
 		}
 		EXPECT_TRUE(batch2.insertObservations(pointers(p), p.robot));
 		// Each camera's memory as one by one: a frame run twice (its first

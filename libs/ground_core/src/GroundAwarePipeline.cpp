@@ -81,7 +81,6 @@ void GroundAwarePipeline::resetResult()
 	m_result.missing = MissingFloorStats{};
 	m_result.camera = CameraModel::Custom;
 	m_result.trust_range = std::numeric_limits<double>::infinity();
-	m_result.remembered_patches = 0;
 	m_result.remembered_planes.clear();
 	m_result.remembered_support.clear();
 	m_missing.clear();
@@ -195,10 +194,9 @@ const FrameResult& GroundAwarePipeline::process(
 	const GroundDetection& judged = m_patchMemory.apply(
 		det, travelled, memory ? m_params.patch_memory : 0.0, det.patch_inlier_distance,
 		m_params.ism.plane_support_radius, m_params.ism.traversable_step);
-	m_result.remembered_patches = m_patchMemory.applied();
 	m_result.remembered_planes.clear();
 	m_result.remembered_support.clear();
-	if (&judged != &det && judged.remembered_from > 0)
+	if (&judged != &det)
 		for (size_t k = judged.remembered_from; k < judged.planes.size(); k++)
 		{
 			m_result.remembered_planes.push_back(judged.planes[k]);

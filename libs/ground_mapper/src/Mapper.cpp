@@ -1,4 +1,5 @@
 #include <gam/common/Strings.h>
+#include <gam/core/PlaneFit.h>
 #include <gam/mapper/Errors.h>
 #include <gam/mapper/Mapper.h>
 #include <gam/mapper/RawlogFrames.h>
@@ -329,7 +330,7 @@ void Mapper::recordFrame(size_t i, const Frame& fr, bool is3D, double ms)
 		for (size_t k = 0; k < gp.patches.size(); k++)
 		{
 			const auto& p = gp.patches[k];
-			const double slope = std::atan2(std::hypot(p.a, p.b), std::abs(p.c)) * 180.0 / M_PI;
+			const double slope = gam::Plane{p.a, p.b, p.c, p.d}.tiltAngle() * 180.0 / M_PI;
 			r.patches << fr.index << "," << k + 1 << "," << p.a << "," << p.b << "," << p.c << "," << p.d << ","
 					  << p.nodes << "," << slope << "," << (p.remembered ? "remembered" : "frame") << ","
 					  << fr.obs->sensorLabel << "\n";

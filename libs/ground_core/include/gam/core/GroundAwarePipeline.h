@@ -139,9 +139,8 @@ struct FrameResult
 	CameraModel camera = CameraModel::Custom;
 	double trust_range = std::numeric_limits<double>::infinity();
 	/** Ramp patches of earlier frames that judged this frame's voxels beside
-	 * detection's planes (patch_memory). */
-	size_t remembered_patches = 0;
-	/** Their planes (map frame) and nodes, in the order the ISM took them. */
+	 * detection's planes (patch_memory): their planes (map frame) and nodes,
+	 * in the order the ISM took them. */
 	std::vector<Plane> remembered_planes;
 	std::vector<size_t> remembered_support;
 	StageTimes ms;
