@@ -462,9 +462,11 @@ void MissingFloorDetector::compute(
 				// Seen floor (or whatever was seen there): its dropouts are
 				// the camera's, not a hole's.
 				const bool onSeen = cls[cellOf[c]] != VoxelClass::None;
-				const bool after = state == 2;
-				afterEmpty += after & onSeen;
-				bothEmpty += after & onSeen & isEmpty;
+				if (state == 2)
+				{
+					afterEmpty += onSeen;
+					bothEmpty += onSeen & isEmpty;
+				}
 				state = uint32_t(onSeen) << uint32_t(isEmpty);
 				if (onSeen & !(T[c] >= runLo && T[c] < runHi))
 				{
