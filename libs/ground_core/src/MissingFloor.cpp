@@ -417,12 +417,13 @@ void MissingFloorDetector::compute(
 		{
 			// A statistics row of a depth image: most of its pixels meet seen
 			// floor. The tests of judgeRay() that need no sample run for the
-			// whole row in one vector loop (judgeableRow), then the pixels
-			// that passed them are counted.
-			// countRay()'s tests and counts, as one loop over the row with
-			// every count in a register (countRay() per pixel, its counters in
-			// memory and a division for the range bin, cost 18 cycles a pixel,
-			// 2026-11-27; this loop 19-27 % less of the stage's time).
+			// whole row in one vector loop (judgeableRow); then countRay()'s
+			// tests and counts in one loop with every count in a register
+			// (countRay() per pixel, its counters in memory and a division for
+			// the range bin, cost 18 cycles a pixel, 2026-11-27; this loop
+			// takes the stage down by 12-32 %, speed-and-memory.md). The tests
+			// are written out again here, not shared with countRay() as
+			// lambdas: shared, the stage took 5-10 % longer (2026-11-28).
 			judgeableRow(rays, bounds, fyRow, fzRow, cols, m_rowT.data(), isCandidate, m_rowCell.data());
 			const float* __restrict T = m_rowT.data();
 			const int32_t* __restrict cellOf = m_rowCell.data();
