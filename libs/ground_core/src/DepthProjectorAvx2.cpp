@@ -4,6 +4,8 @@
 // SSE2 loop and maps do not depend on the CPU. DepthProjector.cpp calls it only when the CPU has AVX2.
 #include "ProjectRow.h"
 
+#include <algorithm>
+
 #if defined(GAM_HAVE_AVX2_ROW_LOOP)
 #include <immintrin.h>
 #endif
@@ -36,6 +38,11 @@ void flyingCandidatesAvx2(
 	uint16_t T, H;
 	flyingCandidateLimits(t, h, T, H);
 	keep[0] = keep[1] = keep[cols - 2] = keep[cols - 1] = 0;
+	if (cols - 4 < 16)
+	{
+		flyingCandidatesIn(u2, u1, row, d1, d2, 2, cols - 2, T, H, keep);
+		return;
+	}
 	const __m256i limit = _mm256_set1_epi16(static_cast<short>(T)), zero = _mm256_setzero_si256();
 	const auto load = [](const uint16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); };
 	// Lanes where |a - b| > T are non-zero.
@@ -66,8 +73,12 @@ void flyingCandidatesAvx2(
 				_mm256_and_si256(atMost(dl, limit), atMost(dr, limit)),
 				_mm256_or_si256(_mm256_and_si256(noP1, notNearR), _mm256_and_si256(noN1, notNearL))));
 	};
-	int c = 2;
-	for (; c + 16 <= cols - 2; c += 16)
+	// The blocks of 16 from column 2; the last one ends at cols - 2 and may
+	// overlap the one before it (a pixel's keep byte depends on the image
+	// alone: written twice, the same). Without it, the 12 pixels left of a
+	// 512-pixel row went through flyingCandidatesIn's scalar loop.
+	const int last = cols - 2 - 16;
+	for (int c = 2;; c = std::min(c + 16, last))
 	{
 		const __m256i x = load(row + c);
 		const __m256i jumps = _mm256_or_si256(
@@ -77,6 +88,7 @@ void flyingCandidatesAvx2(
 		if (_mm256_testz_si256(busy, busy))
 		{
 			_mm_storeu_si128(reinterpret_cast<__m128i*>(keep + c), _mm_set1_epi8(1));
+			if (c == last) break;
 			continue;
 		}
 		// flyingCandidatesIn's tests on 16 lanes (the same 16-bit arithmetic:
@@ -88,8 +100,8 @@ void flyingCandidatesAvx2(
 		_mm_storeu_si128(
 			reinterpret_cast<__m128i*>(keep + c),
 			_mm_packus_epi16(_mm256_castsi256_si128(ones), _mm256_extracti128_si256(ones, 1)));
+		if (c == last) break;
 	}
-	flyingCandidatesIn(u2, u1, row, d1, d2, c, cols - 2, T, H, keep);
 }
 
 namespace
