@@ -250,8 +250,12 @@ void markFlyingRow(const RangeImageView& img, int r, float tol, bool avx2, uint8
 	const uint16_t *u1 = rowAt(r - 1), *u2 = rowAt(r - 2);
 	const uint16_t *d1 = rowAt(r + 1), *d2 = rowAt(r + 2);
 	const int t = int(tol), h = int(tol / 2);
+	// With AVX2 the first pass also lists its candidates (in batch.cols,
+	// which visit() below compacts in place: it writes entry count <= i
+	// after reading entry i).
+	int listed = -1;
 	if (avx2)
-		detail::flyingCandidatesAvx2(u2, u1, row, d1, d2, cols, t, h, keep);
+		listed = detail::flyingCandidatesAvx2(u2, u1, row, d1, d2, cols, t, h, keep, batch.cols);
 	else
 		flyingCandidates(u2, u1, row, d1, d2, cols, t, h, keep);
 	// The candidates are few: skip 8 kept pixels at a time. Gather their
@@ -279,17 +283,22 @@ void markFlyingRow(const RangeImageView& img, int r, float tol, bool avx2, uint8
 		}
 		batch.cols[count++] = c;
 	};
-	int k = 0;
-	for (; k + 8 <= cols; k += 8)
+	if (listed >= 0)
+		for (int i = 0; i < listed; i++) visit(batch.cols[i]);
+	else
 	{
-		uint64_t eight;
-		std::memcpy(&eight, keep + k, 8);
-		if (eight == 0x0101010101010101ull) continue;
-		for (int j = k; j < k + 8; j++)
-			if (!keep[j]) visit(j);
+		int k = 0;
+		for (; k + 8 <= cols; k += 8)
+		{
+			uint64_t eight;
+			std::memcpy(&eight, keep + k, 8);
+			if (eight == 0x0101010101010101ull) continue;
+			for (int j = k; j < k + 8; j++)
+				if (!keep[j]) visit(j);
+		}
+		for (; k < cols; k++)
+			if (!keep[k]) visit(k);
 	}
-	for (; k < cols; k++)
-		if (!keep[k]) visit(k);
 	if (avx2)
 		detail::flyingLinesAvx2(batch.lines, batch.stride, count, tol, batch.along, batch.againstNothing);
 	else

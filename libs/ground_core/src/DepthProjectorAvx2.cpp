@@ -24,9 +24,9 @@ void projectRowAvx2(
 {
 	projectRow(isDepth, p, row, ky, kz, invNorm, cols, cell, z);
 }
-void flyingCandidatesAvx2(
+int flyingCandidatesAvx2(
 	const uint16_t* u2, const uint16_t* u1, const uint16_t* row, const uint16_t* d1, const uint16_t* d2, int cols,
-	int t, int h, uint8_t* keep)
+	int t, int h, uint8_t* keep, int32_t* candidates)
 {
 	// flyingCandidates, but a block of 16 pixels where no pixel with a return
 	// differs by more than t from a neighbour in its row or its column (most
@@ -38,11 +38,16 @@ void flyingCandidatesAvx2(
 	uint16_t T, H;
 	flyingCandidateLimits(t, h, T, H);
 	keep[0] = keep[1] = keep[cols - 2] = keep[cols - 1] = 0;
+	int n = 0;
 	if (cols - 4 < 16)
 	{
 		flyingCandidatesIn(u2, u1, row, d1, d2, 2, cols - 2, T, H, keep);
-		return;
+		for (int c = 0; c < cols; c++)
+			if (!keep[c]) candidates[n++] = c;
+		return n;
 	}
+	candidates[n++] = 0;
+	candidates[n++] = 1;
 	const __m256i limit = _mm256_set1_epi16(static_cast<short>(T)), zero = _mm256_setzero_si256();
 	const auto load = [](const uint16_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); };
 	// Lanes where |a - b| > T are non-zero.
@@ -78,6 +83,7 @@ void flyingCandidatesAvx2(
 	// alone: written twice, the same). Without it, the 12 pixels left of a
 	// 512-pixel row went through flyingCandidatesIn's scalar loop.
 	const int last = cols - 2 - 16;
+	int done = 2;  // the columns before it are listed
 	for (int c = 2;; c = std::min(c + 16, last))
 	{
 		const __m256i x = load(row + c);
@@ -88,6 +94,7 @@ void flyingCandidatesAvx2(
 		if (_mm256_testz_si256(busy, busy))
 		{
 			_mm_storeu_si128(reinterpret_cast<__m128i*>(keep + c), _mm_set1_epi8(1));
+			done = c + 16;
 			if (c == last) break;
 			continue;
 		}
@@ -97,11 +104,19 @@ void flyingCandidatesAvx2(
 		const __m256i calmCol = calm(load(u2 + c), load(u1 + c), x, load(d1 + c), load(d2 + c));
 		const __m256i kept = _mm256_or_si256(_mm256_and_si256(calmRow, calmCol), isZero(x));
 		const __m256i ones = _mm256_srli_epi16(kept, 15);
-		_mm_storeu_si128(
-			reinterpret_cast<__m128i*>(keep + c),
-			_mm_packus_epi16(_mm256_castsi256_si128(ones), _mm256_extracti128_si256(ones, 1)));
+		const __m128i bytes = _mm_packus_epi16(_mm256_castsi256_si128(ones), _mm256_extracti128_si256(ones, 1));
+		_mm_storeu_si128(reinterpret_cast<__m128i*>(keep + c), bytes);
+		// The candidates' columns, in order (those of an overlapping last
+		// block that the block before it listed, not again).
+		unsigned mask = unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(bytes, _mm_setzero_si128())));
+		mask &= ~((1u << (done - c)) - 1u);
+		for (; mask; mask &= mask - 1) candidates[n++] = c + __builtin_ctz(mask);
+		done = c + 16;
 		if (c == last) break;
 	}
+	candidates[n++] = cols - 2;
+	candidates[n++] = cols - 1;
+	return n;
 }
 
 namespace
@@ -163,9 +178,11 @@ void projectRowAvx2(
 	bool, const RowParams&, const uint16_t*, const float*, const float*, const float*, int, int32_t*, float*)
 {
 }
-void flyingCandidatesAvx2(
-	const uint16_t*, const uint16_t*, const uint16_t*, const uint16_t*, const uint16_t*, int, int, int, uint8_t*)
+int flyingCandidatesAvx2(
+	const uint16_t*, const uint16_t*, const uint16_t*, const uint16_t*, const uint16_t*, int, int, int, uint8_t*,
+	int32_t*)
 {
+	return 0;
 }
 size_t compactRowAvx2(const int32_t*, const float*, const uint8_t*, int, uint32_t*, float*, size_t n) { return n; }
 void flyingLinesAvx2(const float*, size_t, int, float, uint8_t*, uint8_t*) {}

@@ -31,9 +31,11 @@ bool avx2RowLoopAvailable();
 void projectRowAvx2(
 	bool isDepth, const RowParams& p, const uint16_t* row, const float* ky, const float* kz, const float* invNorm,
 	int cols, int32_t* cell, float* z);
-void flyingCandidatesAvx2(
+/** flyingCandidates, and the columns of its candidates (keep 0) in order
+ * into candidates (room for cols); returns how many. */
+int flyingCandidatesAvx2(
 	const uint16_t* u2, const uint16_t* u1, const uint16_t* row, const uint16_t* d1, const uint16_t* d2, int cols,
-	int t, int h, uint8_t* keep);
+	int t, int h, uint8_t* keep, int32_t* candidates);
 size_t compactRowAvx2(
 	const int32_t* cell, const float* z, const uint8_t* keep, int cols, uint32_t* outCell, float* outZ, size_t n);
 void flyingLinesAvx2(const float* lines, size_t stride, int count, float tol, uint8_t* along, uint8_t* againstNothing);
