@@ -1,5 +1,9 @@
 #include "gam/core/MissingFloor.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -101,16 +105,27 @@ int candidateRow(
 }
 
 // The pixels of one image row that returned nothing within the range (raw 0,
-// or beyond rawInRange), as a vector loop; returns how many.
-int emptyRow(const uint16_t* __restrict raw, int cols, uint16_t rawInRange, uint8_t* __restrict isEmpty)
+// or beyond rawInRange), as a list of their columns, in order (room for
+// cols); returns how many. Most pixels have a return: 8 at a time are tested in one
+// vector, and only the empty ones are visited.
+int emptyColumns(const uint16_t* __restrict raw, int cols, uint16_t rawInRange, int32_t* __restrict list)
 {
-	int empty = 0;
-	for (int c = 0; c < cols; c++)
+	int n = 0, c = 0;
+#if defined(__SSE2__)
+	const __m128i one = _mm_set1_epi16(1), range = _mm_set1_epi16(static_cast<short>(rawInRange)),
+				  zero = _mm_setzero_si128();
+	for (; c + 8 <= cols; c += 8)
 	{
-		isEmpty[c] = uint8_t(uint16_t(raw[c] - 1) >= rawInRange);
-		empty += isEmpty[c];
+		// raw - 1 >= rawInRange (unsigned, 0 wraps to 65535): rawInRange - (raw - 1) saturates at 0.
+		const __m128i v = _mm_sub_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(raw + c)), one);
+		const __m128i empty = _mm_cmpeq_epi16(_mm_subs_epu16(range, v), zero);
+		for (unsigned mask = unsigned(_mm_movemask_epi8(_mm_packs_epi16(empty, zero))); mask; mask &= mask - 1)
+			list[n++] = c + __builtin_ctz(mask);
 	}
-	return empty;
+#endif
+	for (; c < cols; c++)
+		if (uint16_t(raw[c] - 1) >= rawInRange) list[n++] = c;
+	return n;
 }
 
 // The tests of judgeRay() in compute() that need no sample, for a whole
@@ -498,11 +513,27 @@ void MissingFloorDetector::compute(
 		// Where every ray of the row meets the ground within the range
 		// (rowRays), outside the statistics rows only its empty pixels are
 		// candidates: found from the depths alone, without reading the ray
-		// table (8 bytes a pixel).
-		const int candidates =
-			rowAll == RowRays::Meet && !statsRow
-				? emptyRow(raw, cols, rawInRange, isCandidate)
-				: candidateRow(rays, thrDown, fyRow, fzRow, raw, cols, statsRow, rawInRange, isCandidate);
+		// table (8 bytes a pixel), as a list of their columns (m_rowCell is
+		// free outside the statistics rows). (Outside them prev stays 0:
+		// countRay() returns 0 there.)
+		if (rowAll == RowRays::Meet && !statsRow)
+		{
+			int32_t* emptyCols = m_rowCell.data();
+			const int candidates = emptyColumns(raw, cols, rawInRange, emptyCols);
+			if (8 * candidates > cols)
+			{
+				meetGroundRow(rays, fyRow, fzRow, cols, m_rowT.data(), m_rowCx.data(), m_rowCy.data());
+				for (int i = 0; i < candidates; i++)
+				{
+					const int c = emptyCols[i];
+					judgeRay(c, m_rowT[size_t(c)], m_rowCx[size_t(c)], m_rowCy[size_t(c)]);
+				}
+			}
+			else
+				for (int i = 0; i < candidates; i++) judgeOne(emptyCols[i]);
+			continue;
+		}
+		const int candidates = candidateRow(rays, thrDown, fyRow, fzRow, raw, cols, statsRow, rawInRange, isCandidate);
 		// Where the rays meet the ground: in a vector loop for the whole row
 		// where candidates are many (a statistics row, a row of dropouts),
 		// else one candidate at a time.
