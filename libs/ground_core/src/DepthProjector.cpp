@@ -252,14 +252,14 @@ void markFlyingRow(const RangeImageView& img, int r, float tol, bool avx2, uint8
 	const int t = int(tol), h = int(tol / 2);
 	// With AVX2 the first pass also lists its candidates (in batch.cols,
 	// which visit() below compacts in place: it writes entry count <= i
-	// after reading entry i).
+	// after reading entry i); -1 where they are not listed.
 	int listed = -1;
 	if (avx2)
 		listed = detail::flyingCandidatesAvx2(u2, u1, row, d1, d2, cols, t, h, keep, batch.cols);
 	else
 		flyingCandidates(u2, u1, row, d1, d2, cols, t, h, keep);
-	// The candidates are few: skip 8 kept pixels at a time. Gather their
-	// lines (three pixels each side, 0 beyond the edge).
+	// The candidates are few: read from the list, or skip 8 kept pixels at a
+	// time. Gather their lines (three pixels each side, 0 beyond the edge).
 	const bool innerRow = r >= 3 && r + 3 < rows;
 	const ptrdiff_t down = ptrdiff_t(img.stride);
 	int count = 0;

@@ -38,14 +38,13 @@ int flyingCandidatesAvx2(
 	uint16_t T, H;
 	flyingCandidateLimits(t, h, T, H);
 	keep[0] = keep[1] = keep[cols - 2] = keep[cols - 1] = 0;
-	int n = 0;
 	if (cols - 4 < 16)
 	{
+		// Narrower than a block: keep alone (the caller finds the candidates there).
 		flyingCandidatesIn(u2, u1, row, d1, d2, 2, cols - 2, T, H, keep);
-		for (int c = 0; c < cols; c++)
-			if (!keep[c]) candidates[n++] = c;
-		return n;
+		return -1;
 	}
+	int n = 0;
 	candidates[n++] = 0;
 	candidates[n++] = 1;
 	const __m256i limit = _mm256_set1_epi16(static_cast<short>(T)), zero = _mm256_setzero_si256();

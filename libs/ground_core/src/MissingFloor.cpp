@@ -106,8 +106,8 @@ int candidateRow(
 
 // The pixels of one image row that returned nothing within the range (raw 0,
 // or beyond rawInRange), as a list of their columns, in order (room for
-// cols); returns how many. Most pixels have a return: 8 at a time are tested in one
-// vector, and only the empty ones are visited.
+// cols); returns how many. Most pixels have a return: 8 at a time are tested
+// in one vector, and only the empty ones are visited.
 int emptyColumns(const uint16_t* __restrict raw, int cols, uint16_t rawInRange, int32_t* __restrict list)
 {
 	int n = 0, c = 0;
@@ -514,26 +514,13 @@ void MissingFloorDetector::compute(
 		// (rowRays), outside the statistics rows only its empty pixels are
 		// candidates: found from the depths alone, without reading the ray
 		// table (8 bytes a pixel), as a list of their columns (m_rowCell is
-		// free outside the statistics rows). (Outside them prev stays 0:
-		// countRay() returns 0 there.)
-		if (rowAll == RowRays::Meet && !statsRow)
-		{
-			int32_t* emptyCols = m_rowCell.data();
-			const int candidates = emptyColumns(raw, cols, rawInRange, emptyCols);
-			if (8 * candidates > cols)
-			{
-				meetGroundRow(rays, fyRow, fzRow, cols, m_rowT.data(), m_rowCx.data(), m_rowCy.data());
-				for (int i = 0; i < candidates; i++)
-				{
-					const int c = emptyCols[i];
-					judgeRay(c, m_rowT[size_t(c)], m_rowCx[size_t(c)], m_rowCy[size_t(c)]);
-				}
-			}
-			else
-				for (int i = 0; i < candidates; i++) judgeOne(emptyCols[i]);
-			continue;
-		}
-		const int candidates = candidateRow(rays, thrDown, fyRow, fzRow, raw, cols, statsRow, rawInRange, isCandidate);
+		// free outside the statistics rows). Other rows mark theirs in
+		// isCandidate.
+		const bool listEmpty = rowAll == RowRays::Meet && !statsRow;
+		int32_t* emptyCols = m_rowCell.data();
+		const int candidates =
+			listEmpty ? emptyColumns(raw, cols, rawInRange, emptyCols)
+					  : candidateRow(rays, thrDown, fyRow, fzRow, raw, cols, statsRow, rawInRange, isCandidate);
 		// Where the rays meet the ground: in a vector loop for the whole row
 		// where candidates are many (a statistics row, a row of dropouts),
 		// else one candidate at a time.
@@ -548,6 +535,12 @@ void MissingFloorDetector::compute(
 			else
 				judgeOne(c);
 		};
+		if (listEmpty)
+		{
+			// (prev stays 0 outside the statistics rows: countRay() returns 0 there.)
+			for (int i = 0; i < candidates; i++) judge(emptyCols[i]);
+			continue;
+		}
 		// They are few: skip eight pixels without one at a time.
 		int c = 0;
 		for (; c + 8 <= cols; c += 8)

@@ -32,7 +32,8 @@ void projectRowAvx2(
 	bool isDepth, const RowParams& p, const uint16_t* row, const float* ky, const float* kz, const float* invNorm,
 	int cols, int32_t* cell, float* z);
 /** flyingCandidates, and the columns of its candidates (keep 0) in order
- * into candidates (room for cols); returns how many. */
+ * into candidates (room for cols); returns how many, or -1 for a row
+ * narrower than 20 pixels, whose candidates it does not list. */
 int flyingCandidatesAvx2(
 	const uint16_t* u2, const uint16_t* u1, const uint16_t* row, const uint16_t* d1, const uint16_t* d2, int cols,
 	int t, int h, uint8_t* keep, int32_t* candidates);
