@@ -281,6 +281,55 @@ TEST(ElevationGridFilter, KeepsInliersFarFromZeroHeight)
 	}
 }
 
+TEST(ElevationGridFilter, AFlyingPixelLeavesTheKeptSamplesMeanAndVariance)
+{
+	// The cell's sums are taken relative to its first sample, and the second
+	// pass subtracts the outliers from them. Here the first sample is a
+	// flying pixel 1 m above a floor at z = 10 m with 1 mm noise: every kept
+	// sample's deviation from it is ~1 m, and their spread is 1e-6 of that.
+	// The kept samples' mean and variance must still be theirs (float sums
+	// lost the spread entirely: variance off by 100 %).
+	std::mt19937 rng(7);
+	std::normal_distribution<float> N(0.f, 0.001f);
+	const float base = 10.0f, flying = base + 1.0f;
+	std::vector<float> clean;
+	for (int i = 0; i < 400; i++) clean.push_back(base + N(rng));
+	// Premise, in double: the 401 samples' band mean +- 3 std excludes the
+	// flying pixel only. (mean ~ 10 + 1/401 = 10.0025, std ~ sqrt(400)/401 ~ 0.05.)
+	double all = flying;
+	for (float z : clean) all += z;
+	const double mAll = all / 401;
+	double m2All = (flying - mAll) * (flying - mAll);
+	for (float z : clean) m2All += (z - mAll) * (z - mAll);
+	const double band = 3 * std::sqrt(m2All / 401);
+	ASSERT_GT(std::abs(flying - mAll), band);
+	for (float z : clean) ASSERT_LE(std::abs(z - mAll), band);
+	// Expected: the clean samples' own mean and population variance.
+	double m = 0;
+	for (float z : clean) m += z;
+	m /= 400;
+	double var = 0;
+	for (float z : clean) var += (z - m) * (z - m);
+	var /= 400;  // ~1e-6 (1 mm noise)
+
+	// The flying pixel first (the sums' reference), then last.
+	for (bool first : {true, false})
+	{
+		ElevationGrid grid(makeGeometry(0, 0, 1.0, 2, 2));
+		BinnedPoints b;
+		if (first) grid.binPoint(0.5, 0.5, flying, b);
+		for (float z : clean) grid.binPoint(0.5, 0.5, z, b);
+		if (!first) grid.binPoint(0.5, 0.5, flying, b);
+		EXPECT_EQ(grid.insert(b, OutlierFilterParams{}), 400u) << first;
+		const ElevationCell& c = grid.cell(0, 0);
+		EXPECT_EQ(c.count, 400u) << first;
+		EXPECT_FLOAT_EQ(c.z_max, *std::max_element(clean.begin(), clean.end())) << first;
+		EXPECT_FLOAT_EQ(c.z_min, *std::min_element(clean.begin(), clean.end())) << first;
+		EXPECT_NEAR(c.mean(), m, 2e-6) << first;  // a float z_sum of 4000 m holds 2.4e-4 / 400
+		EXPECT_NEAR(c.variance(), var, 0.01 * var) << first;
+	}
+}
+
 TEST(ElevationGridFilter, MinimumBand)
 {
 	// {0 x8, 0.004 x2}: mean 0.0008, std 0.0016. A 1-sigma band (+-1.6 mm)
