@@ -89,17 +89,14 @@ namespace
 // rule needs the std of each cell in one pass; the textbook E[z^2] - E[z]^2 of
 // plain float sums cancels catastrophically when |z| >> std (a floor at
 // z = 10 m with 3 mm noise got std ~0 and lost 15% of its samples), while the
-// deviations from a sample of the same cell are at most the cell's span. The
-// sums are doubles because the second pass subtracts outliers from them (see
-// insert()); against float sums they cost the 3-sigma stage 0-3 % (D435,
-// Femto, Kinect One demos, 6 alternating runs, 2026-11-29).
+// deviations from a sample of the same cell are at most the cell's span.
 inline void accumulate(ElevationGrid::FrameCell& a, float z)
 {
 	if (!a.count) a.ref = z;
 	const float d = z - a.ref;
 	a.count++;
 	a.s1 += d;
-	a.s2 += double(d) * d;
+	a.s2 += d * d;
 	a.z_min = std::min(a.z_min, z);
 	a.z_max = std::max(a.z_max, z);
 }
@@ -164,58 +161,38 @@ size_t ElevationGrid::insert(const BinnedPoints& pts, const OutlierFilterParams&
 	{
 		FrameCell& a = m_frame[c];
 		if (!filter.enabled || a.count < filter.min_count) continue;
-		const double m1 = a.s1 / a.count;
-		const double var = std::max(0.0, a.s2 / a.count - m1 * m1);
-		const float lim = std::max(filter.min_band, float(filter.sigmas * std::sqrt(var)));
-		const float mean = float(a.ref + m1);
+		const float inv = 1.0f / float(a.count);
+		const float m1 = a.s1 * inv;
+		const float var = std::max(0.f, a.s2 * inv - m1 * m1);
+		const float lim = std::max(filter.min_band, filter.sigmas * std::sqrt(var));
+		const float mean = a.ref + m1;
 		if (mean - lim <= a.z_min && mean + lim >= a.z_max) continue;
 		m_filterMean[c] = mean;
 		m_filterLimit[c] = lim;
 		m_flagged[c] = 1;
 		flaggedCount += a.count;
-		// Pass 2 takes the outliers out of the sums and finds the kept
-		// samples' extremes again.
-		a.z_min = std::numeric_limits<float>::infinity();
-		a.z_max = -std::numeric_limits<float>::infinity();
+		a = FrameCell{};
 		flagged++;
 	}
 	size_t kept = n;
 	if (flagged)
 	{
-		// Pass 2, only if some cell had outliers: subtract the flagged
-		// cells' outliers from their sums (about 1 % of their samples) and
-		// take the kept samples' minimum and maximum again. Re-accumulating
-		// the kept samples instead did the whole first pass's work again
-		// (D435 demo: 68 k samples read to remove 591). The sums are in
-		// double: where the first sample, their reference, is itself an
-		// outlier (a flying pixel 1 m off a floor with 1 mm noise), every
-		// kept deviation is ~1 m and float sums lost the kept spread.
-		// A byte per cell tells which cells are flagged: it stays in the L1
-		// cache. (Four quarters of the list in lockstep, as pass 1.) Where
-		// their samples are under 1/8 of the frame's, most blocks of 16
-		// samples hold none: they are skipped (listing a Kinect One frame
-		// whose flagged cells hold 2 % of its samples, 78 -> 55 us; a Femto
-		// or D435 frame's hold 25-30 %, where skipping costs 25 %).
+		// Pass 2, only if some cell had outliers: re-accumulate the flagged
+		// cells (a byte per cell tells which: it stays in the L1 cache).
+		// (Four quarters of the list in lockstep, as pass 1.) Where their
+		// samples are under 1/8 of the frame's, most blocks of 16 samples
+		// hold none: they are skipped (listing a Kinect One frame whose
+		// flagged cells hold 2 % of its samples, 78 -> 55 us; a Femto or
+		// D435 frame's hold 25-30 %, where skipping costs 25 %).
 		const bool fewFlagged = 8 * flaggedCount < n;
 		const size_t listed = samplesInMarkedCells(pts, m_flagged.data(), m_flaggedSamples, fewFlagged);
 		const auto readd = [&](size_t k) {
 			const uint32_t i = m_flaggedSamples[k];
 			const uint32_t c = cellOf[i];
-			const float z = zOf[i];
-			FrameCell& a = m_frame[c];
-			if (std::abs(z - m_filterMean[c]) <= m_filterLimit[c])
-			{
-				a.z_min = std::min(a.z_min, z);
-				a.z_max = std::max(a.z_max, z);
-			}
+			if (std::abs(zOf[i] - m_filterMean[c]) <= m_filterLimit[c])
+				accumulate(m_frame[c], zOf[i]);
 			else
-			{
-				const float d = z - a.ref;
-				a.count--;
-				a.s1 -= d;
-				a.s2 -= double(d) * d;
 				kept--;
-			}
 		};
 		inLockstepQuarters(listed, readd);
 	}

@@ -278,8 +278,7 @@ class ElevationGrid
 	/** One frame's samples of a cell, relative to its first sample (see insert()). */
 	struct FrameCell
 	{
-		double s1 = 0, s2 = 0;
-		float ref = 0;
+		float ref = 0, s1 = 0, s2 = 0;
 		float z_min = std::numeric_limits<float>::infinity();
 		float z_max = -std::numeric_limits<float>::infinity();
 		uint32_t count = 0;
