@@ -102,28 +102,17 @@ double InverseSensorModel::rangeFrom(const Eigen::Vector3d& sensor, double x, do
 
 double InverseSensorModel::groundBand(const Eigen::Vector3d& sensor, double h, double x, double y, double z) const
 {
-	return floorBandAt(rangeFrom(sensor, x, y, z), h).band;
-}
-
-InverseSensorModel::FloorBand InverseSensorModel::floorBandAt(double r, double h) const
-{
-	FloorBand out{m_params.d_pth, -1};
-	const bool noise = m_params.noise_sigmas > 0;
-	if (!noise && !m_params.measure_floor_offset) return out;
-	const size_t bin = size_t(r / m_params.floor_noise_bin);
-	if (m_params.measure_floor_offset && bin < m_floorOffset.size()) out.offset = double(m_floorOffset[bin]);
-	if (!noise || r < 1e-3) return out;
+	if (m_params.noise_sigmas <= 0) return m_params.d_pth;
+	const double r = rangeFrom(sensor, x, y, z);
+	if (r < 1e-3) return m_params.d_pth;
 	// The floor's vertical scatter measured in this frame at this range, if
 	// enough floor was seen there; else the sensor model.
+	const size_t bin = size_t(r / m_params.floor_noise_bin);
 	if (bin < m_floorNoise.size() && m_floorNoise[bin] >= 0)
-	{
-		out.band = m_params.d_pth + m_params.noise_sigmas * double(m_floorNoise[bin]);
-		return out;
-	}
+		return m_params.d_pth + m_params.noise_sigmas * double(m_floorNoise[bin]);
 	const double sd = m_params.depth_noise_c0 + m_params.depth_noise_c2 * r * r;
 	const double sinElev = std::clamp(std::abs(h) / r, 0.0, 1.0);
-	out.band = m_params.d_pth + m_params.noise_sigmas * sd * sinElev;
-	return out;
+	return m_params.d_pth + m_params.noise_sigmas * sd * sinElev;
 }
 
 void InverseSensorModel::measureFloorNoise(
@@ -191,7 +180,9 @@ void InverseSensorModel::measureFloorNoise(
 
 double InverseSensorModel::floorOffset(const Eigen::Vector3d& sensor, double x, double y, double z) const
 {
-	return floorBandAt(rangeFrom(sensor, x, y, z), 0).offset;
+	if (!m_params.measure_floor_offset) return -1;
+	const size_t bin = size_t(rangeFrom(sensor, x, y, z) / m_params.floor_noise_bin);
+	return bin < m_floorOffset.size() ? double(m_floorOffset[bin]) : -1;
 }
 
 VoxelClass InverseSensorModel::classify(
@@ -589,9 +580,8 @@ void InverseSensorModel::compute(
 			const int block = (cy / m_blockCells) * m_bnx + (cx / m_blockCells);
 			const Plane& pl = choosePlane(det, c, x, y, block);
 			const double hs = pl.signedDistance(sensor.x(), sensor.y(), sensor.z());
-			// The band and the floor offset from one range and one bin.
-			const FloorBand fb = floorBandAt(rangeFrom(sensor, x, y, c.mean()), hs);
-			const double band = fb.band, tau = fb.offset;
+			const double band = groundBand(sensor, hs, x, y, c.mean());
+			const double tau = floorOffset(sensor, x, y, c.mean());
 			cls = classify(c, x, y, pl, band, dMean, tau);
 			if (haveSamples && pl.c > 0 && (cls == VoxelClass::Obstacle || cls == VoxelClass::Drop) &&
 				c.count >= minPoints())

@@ -421,12 +421,6 @@ class InverseSensorModel
 	/** Distance of (x, y, z) from the sensor: the range the floor-noise and
 	 * floor-offset bins are indexed by. */
 	static double rangeFrom(const Eigen::Vector3d& sensor, double x, double y, double z);
-	/** groundBand() and floorOffset() of a voxel at range r (h: as groundBand()). */
-	struct FloorBand
-	{
-		double band, offset;
-	};
-	FloorBand floorBandAt(double r, double h) const;
 	void put(uint32_t cell, float p);
 	void computePaper(
 		const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, IsmStats& stats);
