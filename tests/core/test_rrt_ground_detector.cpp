@@ -660,3 +660,53 @@ TEST(RrtGroundDetector, PatchSlopeWeighsNodeCentresAndLocalPlanesByTheirPrecisio
 	EXPECT_NEAR(exact.x(), 0.12, 1e-12);
 	EXPECT_NEAR(exact.y(), -0.03, 1e-12);
 }
+
+// The nearest-node query of RRT-GPD (nearestPoint): the nearest of n points,
+// ties to the lowest index, whichever of its four lanes (index mod 4) or its
+// scalar tail (the last n mod 4 points) holds the candidates. Lanes see
+// indices 0 .. 4 floor(n / 4) - 1.
+TEST(RrtNearestPoint, FindsTheNearestAndBreaksTiesTowardTheLowestIndex)
+{
+	// Query (0, 0). Squared distances, by hand: (3, 4) -> 25, (0, 2) -> 4,
+	// (1, 1) -> 2, (-1, 1) -> 2, (2, 0) -> 4, (0, -1.5) -> 2.25, (1, -1) -> 2.
+	// Indices 2, 3 and 6 tie at 2 (lanes 2 and 3, and the tail): index 2 wins.
+	const float xs[] = {3.f, 0.f, 1.f, -1.f, 2.f, 0.f, 1.f};
+	const float ys[] = {4.f, 2.f, 1.f, 1.f, 0.f, -1.5f, -1.f};
+	float d2 = -1.f;
+	EXPECT_EQ(nearestPoint(xs, ys, 7, 0.f, 0.f, d2), 2u);
+	EXPECT_EQ(d2, 2.f);
+	// Without index 2 (the first five from index 3): 3 (d2 2, lane 0) ties
+	// with 6 (lane 3): 3 wins, reported as index 0 of the shifted arrays.
+	EXPECT_EQ(nearestPoint(xs + 3, ys + 3, 4, 0.f, 0.f, d2), 0u);
+	EXPECT_EQ(d2, 2.f);
+	// A tie across lanes where the higher lane holds the lower index: points
+	// 1 (lane 1) and 4 (lane 0) at the same distance 1 from (0, 0); 1 wins.
+	const float tx[] = {5.f, 1.f, 5.f, 5.f, -1.f, 5.f, 5.f, 5.f};
+	const float ty[] = {5.f, 0.f, 5.f, 5.f, 0.f, 5.f, 5.f, 5.f};
+	EXPECT_EQ(nearestPoint(tx, ty, 8, 0.f, 0.f, d2), 1u);
+	EXPECT_EQ(d2, 1.f);
+	// A tie within one lane: points 1 and 5 (both lane 1) at distance 1;
+	// 1 wins.
+	const float wx[] = {5.f, 0.f, 5.f, 5.f, 5.f, 0.f, 5.f, 5.f};
+	const float wy[] = {5.f, 1.f, 5.f, 5.f, 5.f, -1.f, 5.f, 5.f};
+	EXPECT_EQ(nearestPoint(wx, wy, 8, 0.f, 0.f, d2), 1u);
+	EXPECT_EQ(d2, 1.f);
+	// The nearest in the scalar tail (index 9 of 10: lanes hold 0-7, the
+	// tail 8 and 9): (0.5, 0) at d2 0.25 beats every (5, 5) and (1, 0).
+	float ux[] = {5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 1.f, 0.5f};
+	float uy[] = {5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 0.f, 0.f};
+	EXPECT_EQ(nearestPoint(ux, uy, 10, 0.f, 0.f, d2), 9u);
+	EXPECT_EQ(d2, 0.25f);
+	// A tie between a lane (index 1) and the tail (index 8): the lane's.
+	ux[1] = 0.f;
+	uy[1] = 0.5f;
+	ux[9] = 5.f;
+	ux[8] = -0.5f;
+	EXPECT_EQ(nearestPoint(ux, uy, 10, 0.f, 0.f, d2), 1u);
+	EXPECT_EQ(d2, 0.25f);
+	// Fewer than four points (no lanes), and one point.
+	EXPECT_EQ(nearestPoint(xs + 4, ys + 4, 3, 0.f, 0.f, d2), 2u);  // (1, -1): 2 < 2.25 < 4
+	EXPECT_EQ(d2, 2.f);
+	EXPECT_EQ(nearestPoint(xs, ys, 1, 0.f, 0.f, d2), 0u);
+	EXPECT_EQ(d2, 25.f);
+}

@@ -116,6 +116,13 @@ struct RrtGpdParams
 	void validate() const;
 };
 
+/** Index of the point (xs[i], ys[i]), i < n, nearest to (qx, qy), its squared
+ * distance in d2; n must be > 0. Exact: the distance is computed as nanoflann's
+ * L2_Simple_Adaptor<float> does ((qx - x)^2 + (qy - y)^2 in float, each
+ * operation rounded, no fused multiply-add), and on an exact tie the lowest
+ * index wins. RRT-GPD's nearest-node query. */
+uint32_t nearestPoint(const float* xs, const float* ys, size_t n, float qx, float qy, float& d2);
+
 struct GroundNode
 {
 	float x = 0, y = 0, z = 0;  ///< centre (cell centre, surface height)
@@ -377,10 +384,10 @@ class RrtGroundDetector
 	size_t maxTreeNodes(const GridGeometry& g) const;
 
 	// Nearest tree node to a query point (the "nodes in a k-d tree" of the
-	// paper), as a uniform bucket grid over the frame grid: see growTree().
-	void nodeIndexReset(const GridGeometry& g);
-	void nodeIndexAdd(uint32_t node, int cx, int cy);
-	uint32_t nodeIndexNearest(const std::vector<GroundNode>& nodes, float qx, float qy, float& d2) const;
+	// paper): every node's centre tested, from arrays of the centres.
+	void nodeIndexReset();
+	void nodeIndexAdd(const GroundNode& node);
+	uint32_t nodeIndexNearest(float qx, float qy, float& d2) const;
 
 	RrtGpdParams m_params;
 	std::mt19937 m_rng;
@@ -393,12 +400,9 @@ class RrtGroundDetector
 	std::vector<std::pair<int, int>> m_ringOffsets;
 	std::vector<uint8_t> m_seedExcluded;
 	int m_ringRadius = -1;
-	// Node index: per bucket the first node (-1 = empty), per node the next one.
-	std::vector<int32_t> m_bucketHead;
-	std::vector<int32_t> m_bucketNext;
-	std::vector<uint32_t> m_bucketsUsed;
-	int m_bucketCells = 1, m_bnx = 0, m_bny = 0;
-	double m_bucketSize = 0, m_bucketX0 = 0, m_bucketY0 = 0;
+	// Node index: the tree's node centres in node order (x and y apart, so
+	// that four are tested at once).
+	std::vector<float> m_nodeX, m_nodeY;
 	// fitPlanes():
 	std::vector<size_t> m_remaining, m_rest;
 	std::vector<uint8_t> m_flag;
