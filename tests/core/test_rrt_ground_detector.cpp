@@ -6,6 +6,8 @@
 #include <iostream>
 #include <random>
 #include <stdexcept>
+#include <tuple>
+#include <vector>
 
 #include "gam/core/RrtGroundDetector.h"
 #include "test_helpers.h"
@@ -662,51 +664,67 @@ TEST(RrtGroundDetector, PatchSlopeWeighsNodeCentresAndLocalPlanesByTheirPrecisio
 }
 
 // The nearest-node query of RRT-GPD (nearestPoint): the nearest of n points,
-// ties to the lowest index, whichever of its four lanes (index mod 4) or its
-// scalar tail (the last n mod 4 points) holds the candidates. Lanes see
-// indices 0 .. 4 floor(n / 4) - 1.
+// ties to the lowest index, wherever the candidates lie: it tests four
+// points a step in four lanes (lane j: indices j, j + 4, ..., up to
+// 4 floor(n / 4) - 1), the rest one by one (the tail).
+namespace
+{
+// n points at (5, 5), but for the given (index, x, y).
+struct PointSet
+{
+	std::vector<float> x, y;
+	PointSet(size_t n, std::initializer_list<std::tuple<size_t, float, float>> at) : x(n, 5.f), y(n, 5.f)
+	{
+		for (const auto& [i, px, py] : at)
+		{
+			x[i] = px;
+			y[i] = py;
+		}
+	}
+	uint32_t nearest(float& d2) const { return nearestPoint(x.data(), y.data(), x.size(), 0.f, 0.f, d2); }
+};
+}  // namespace
+
 TEST(RrtNearestPoint, FindsTheNearestAndBreaksTiesTowardTheLowestIndex)
 {
-	// Query (0, 0). Squared distances, by hand: (3, 4) -> 25, (0, 2) -> 4,
-	// (1, 1) -> 2, (-1, 1) -> 2, (2, 0) -> 4, (0, -1.5) -> 2.25, (1, -1) -> 2.
-	// Indices 2, 3 and 6 tie at 2 (lanes 2 and 3, and the tail): index 2 wins.
-	const float xs[] = {3.f, 0.f, 1.f, -1.f, 2.f, 0.f, 1.f};
-	const float ys[] = {4.f, 2.f, 1.f, 1.f, 0.f, -1.5f, -1.f};
 	float d2 = -1.f;
-	EXPECT_EQ(nearestPoint(xs, ys, 7, 0.f, 0.f, d2), 2u);
+	// Query (0, 0) throughout; every other point at (5, 5), d2 = 50.
+	// Squared distances by hand: (3, 4) -> 25, (0, 2) -> 4, (1, 1) -> 2,
+	// (-1, 1) -> 2, (0, -1.5) -> 2.25, (1, -1) -> 2, (1, 0) -> 1,
+	// (0.5, 0) -> 0.25.
+	// Fewer than four points (all in the tail): 1 and 2 tie at d2 = 2, 0 is
+	// at 25: 1 wins.
+	const PointSet few(3, {{0, 3.f, 4.f}, {1, 1.f, 1.f}, {2, -1.f, 1.f}});
+	EXPECT_EQ(few.nearest(d2), 1u);
 	EXPECT_EQ(d2, 2.f);
-	// Without index 2 (the first five from index 3): 3 (d2 2, lane 0) ties
-	// with 6 (lane 3): 3 wins, reported as index 0 of the shifted arrays.
-	EXPECT_EQ(nearestPoint(xs + 3, ys + 3, 4, 0.f, 0.f, d2), 0u);
+	// One point.
+	EXPECT_EQ(PointSet(1, {{0, 3.f, 4.f}}).nearest(d2), 0u);
+	EXPECT_EQ(d2, 25.f);
+	// n = 7: lanes hold 0-3, the tail 4-6. Indices 2 (lane 2), 3 (lane 3)
+	// and 6 (tail) tie at 2; 2 wins.
+	const PointSet seven(
+		7, {{0, 3.f, 4.f}, {1, 0.f, 2.f}, {2, 1.f, 1.f}, {3, -1.f, 1.f}, {5, 0.f, -1.5f}, {6, 1.f, -1.f}});
+	EXPECT_EQ(seven.nearest(d2), 2u);
 	EXPECT_EQ(d2, 2.f);
-	// A tie across lanes where the higher lane holds the lower index: points
-	// 1 (lane 1) and 4 (lane 0) at the same distance 1 from (0, 0); 1 wins.
-	const float tx[] = {5.f, 1.f, 5.f, 5.f, -1.f, 5.f, 5.f, 5.f};
-	const float ty[] = {5.f, 0.f, 5.f, 5.f, 0.f, 5.f, 5.f, 5.f};
-	EXPECT_EQ(nearestPoint(tx, ty, 8, 0.f, 0.f, d2), 1u);
+	// A tie across lanes where the later lane holds the lower index: 8
+	// (lane 0) and 1 (lane 1) at d2 = 1: 1 wins.
+	EXPECT_EQ(PointSet(16, {{8, 1.f, 0.f}, {1, -1.f, 0.f}}).nearest(d2), 1u);
 	EXPECT_EQ(d2, 1.f);
-	// A tie within one lane: points 1 and 5 (both lane 1) at distance 1;
-	// 1 wins.
-	const float wx[] = {5.f, 0.f, 5.f, 5.f, 5.f, 0.f, 5.f, 5.f};
-	const float wy[] = {5.f, 1.f, 5.f, 5.f, 5.f, -1.f, 5.f, 5.f};
-	EXPECT_EQ(nearestPoint(wx, wy, 8, 0.f, 0.f, d2), 1u);
+	// ... and where the earlier lane holds the lower index: 1 (lane 1) and
+	// 6 (lane 2), and 13 (lane 1) too, at d2 = 1: 1 wins.
+	EXPECT_EQ(PointSet(16, {{1, 1.f, 0.f}, {6, -1.f, 0.f}, {13, 0.f, 1.f}}).nearest(d2), 1u);
 	EXPECT_EQ(d2, 1.f);
-	// The nearest in the scalar tail (index 9 of 10: lanes hold 0-7, the
-	// tail 8 and 9): (0.5, 0) at d2 0.25 beats every (5, 5) and (1, 0).
-	float ux[] = {5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 1.f, 0.5f};
-	float uy[] = {5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 5.f, 0.f, 0.f};
-	EXPECT_EQ(nearestPoint(ux, uy, 10, 0.f, 0.f, d2), 9u);
+	// A tie within one lane: 3 and 11 (both lane 3) at d2 = 1; 3 wins.
+	EXPECT_EQ(PointSet(16, {{3, 0.f, 1.f}, {11, 0.f, -1.f}}).nearest(d2), 3u);
+	EXPECT_EQ(d2, 1.f);
+	// The nearest in the tail (n = 10: lanes hold 0-7, the tail 8 and 9).
+	EXPECT_EQ(PointSet(10, {{8, 1.f, 0.f}, {9, 0.5f, 0.f}}).nearest(d2), 9u);
 	EXPECT_EQ(d2, 0.25f);
 	// A tie between a lane (index 1) and the tail (index 8): the lane's.
-	ux[1] = 0.f;
-	uy[1] = 0.5f;
-	ux[9] = 5.f;
-	ux[8] = -0.5f;
-	EXPECT_EQ(nearestPoint(ux, uy, 10, 0.f, 0.f, d2), 1u);
+	EXPECT_EQ(PointSet(10, {{1, 0.f, 0.5f}, {8, -0.5f, 0.f}}).nearest(d2), 1u);
 	EXPECT_EQ(d2, 0.25f);
-	// Fewer than four points (no lanes), and one point.
-	EXPECT_EQ(nearestPoint(xs + 4, ys + 4, 3, 0.f, 0.f, d2), 2u);  // (1, -1): 2 < 2.25 < 4
+	// Nearer points later in the same lane replace earlier ones: lane 0 holds
+	// 0 (d2 25), 4 (4), 8 (2); lane 1 holds 5 (2.25): 8 wins.
+	EXPECT_EQ(PointSet(12, {{0, 3.f, 4.f}, {4, 0.f, 2.f}, {8, 1.f, 1.f}, {5, 0.f, -1.5f}}).nearest(d2), 8u);
 	EXPECT_EQ(d2, 2.f);
-	EXPECT_EQ(nearestPoint(xs, ys, 1, 0.f, 0.f, d2), 0u);
-	EXPECT_EQ(d2, 25.f);
 }
