@@ -1,8 +1,8 @@
 // Per-stage and whole-pipeline timings of the ground-aware grid, and the two
 // comparison maps on the same frames, with Google Benchmark (Release build).
 //
-//   gam-bench [--frames=N] [--decimation=N] [--full-octomap=M] [--no-summary] FILE.rawlog [FILE.rawlog ...]
-//             [benchmark flags]
+//   gam-bench [--frames=N] [--decimation=N] [--runs=R] [--full-octomap=M] [--no-summary] FILE.rawlog
+//             [FILE.rawlog ...] [benchmark flags]
 //
 // Each rawlog's 3D frames (up to N, default 20) are loaded once; every case
 // cycles through them. After the cases, a summary prints median and p95 ms
@@ -10,8 +10,13 @@
 // frames, and the ratios; then the ground-aware grid's stages (median / p95);
 // where height_band's time goes (MRPT's convertTo2DScan, the scan's insertion)
 // next to the same band as a plain loop; with --full-octomap=M, also the
-// octomap fed every pixel (first M frames). --no-summary: the cases only (a
-// profile of the default alone, e.g. under callgrind; before/after stage timings).
+// octomap fed every pixel (first M frames). --runs=R: the summary's maps are
+// run R times over the same frames (one after the other, each time in the same
+// order) and every figure printed is the median of the R runs' figures (a
+// ratio too: each run's ratio is within one run); the machine's noise only
+// adds time, and a shared machine's minutes differ. --no-summary: the cases
+// only (a profile of the default alone, e.g. under callgrind; before/after
+// stage timings).
 #include <benchmark/benchmark.h>
 #include <gam/core/CameraNoise.h>
 #include <gam/maps/ObservationAdapters.h>
@@ -173,6 +178,27 @@ double quantile(std::vector<double> v, double q)
 	return v[std::min(v.size() - 1, size_t(q * double(v.size())))];
 }
 
+// One printed figure over the summary's runs: each run's median and p95 (of
+// its frames), and the median of those over the runs.
+struct Figure
+{
+	std::vector<double> q50, q95;
+	void add(const std::vector<double>& v)
+	{
+		q50.push_back(quantile(v, 0.5));
+		q95.push_back(quantile(v, 0.95));
+	}
+	double median() const { return quantile(q50, 0.5); }
+	double p95() const { return quantile(q95, 0.5); }
+};
+// The median over the runs of a per-run ratio a / b of medians.
+double medianRatio(const Figure& a, const Figure& b)
+{
+	std::vector<double> r;
+	for (size_t i = 0; i < a.q50.size() && i < b.q50.size(); i++) r.push_back(a.q50[i] / b.q50[i]);
+	return quantile(r, 0.5);
+}
+
 // The ground-aware grid's own per-stage timings (lastFrame()), frame by frame.
 struct StageSeries
 {
@@ -189,6 +215,24 @@ struct StageSeries
 		missing.push_back(l.missing);
 		update.push_back(grid.lastFrameTimes().update);
 		total.push_back(grid.lastFrameTimes().total);
+	}
+};
+
+// A StageSeries' figures over the summary's runs.
+struct StageFigures
+{
+	Figure projection, outliers, ground, ism, missing, update, total;
+	gam::CameraModel camera = gam::CameraModel::Custom;
+	void add(const StageSeries& s)
+	{
+		camera = s.camera;
+		projection.add(s.projection);
+		outliers.add(s.outliers);
+		ground.add(s.ground);
+		ism.add(s.ism);
+		missing.add(s.missing);
+		update.add(s.update);
+		total.add(s.total);
 	}
 };
 
@@ -278,6 +322,7 @@ int main(int argc, char** argv)
 	size_t maxFrames = 20;
 	int decimation = 1;  // > 1: also the default with every n-th pixel row and column
 	int fullOctomapFrames = 0;
+	int runs = 1;  // the summary's runs: every figure the median of theirs
 	bool summary = true;
 	std::vector<std::string> files;
 	std::vector<char*> bargs{argv[0]};
@@ -287,6 +332,8 @@ int main(int argc, char** argv)
 			maxFrames = size_t(std::max(1, std::atoi(argv[i] + 9)));
 		else if (std::strncmp(argv[i], "--decimation=", 13) == 0)
 			decimation = std::max(1, std::atoi(argv[i] + 13));
+		else if (std::strncmp(argv[i], "--runs=", 7) == 0)
+			runs = std::max(1, std::atoi(argv[i] + 7));
 		else if (std::strncmp(argv[i], "--full-octomap=", 15) == 0)
 			fullOctomapFrames = std::max(0, std::atoi(argv[i] + 15));
 		else if (std::strcmp(argv[i], "--no-summary") == 0)
@@ -298,7 +345,8 @@ int main(int argc, char** argv)
 	}
 	if (files.empty())
 	{
-		std::cerr << "usage: gam-bench [--frames=N] [--decimation=N] [--full-octomap=M] [--no-summary] FILE.rawlog "
+		std::cerr << "usage: gam-bench [--frames=N] [--decimation=N] [--runs=R] [--full-octomap=M] [--no-summary] "
+					 "FILE.rawlog "
 					 "[...] [benchmark flags]\n";
 		return 2;
 	}
@@ -334,63 +382,87 @@ int main(int argc, char** argv)
 	benchmark::Shutdown();
 	if (!summary) return 0;
 
-	// Each map once over the same frames; the ground-aware run also records its
-	// stages, and so does the same grid in paper mode (ism_model = rrt_variant = paper).
-	std::vector<StageSeries> stages(g_data.size()), paperStages(g_data.size()), decimatedStages(g_data.size());
-	std::vector<double> groundAwareMedian(g_data.size());
+	// Each map over the same frames, `runs` times; the ground-aware run also
+	// records its stages, and so does the same grid in paper mode (ism_model =
+	// rrt_variant = paper) and, with --decimation, decimated.
+	const size_t D = g_data.size();
+	std::vector<Figure> ga(D), hb(D), om(D), hbConvert(D), hbInsert(D), hbPlain(D);
+	std::vector<StageFigures> stages(D), paperStages(D), decimatedStages(D);
+	for (int run = 0; run < runs; run++)
+	{
+		if (runs > 1) std::fprintf(stderr, "gam-bench: summary run %d of %d\n", run + 1, runs);
+		for (size_t k = 0; k < D; k++)
+		{
+			const Dataset& d = g_data[k];
+			const int rounds = roundsFor(d);
+			StageSeries def, paper, decimated;
+			ga[k].add(timesOf<CGroundAwareOccupancyGrid>(
+				d, rounds, 0, {}, [&](const CGroundAwareOccupancyGrid& g) { def.add(g); }));
+			stages[k].add(def);
+			timesOf<CGroundAwareOccupancyGrid>(
+				d, rounds, 0,
+				[](CGroundAwareOccupancyGrid& g) {
+					auto o = g.groundOptions();
+					o.pipeline.ism.model = gam::MethodVariant::Paper;
+					o.pipeline.rrt.variant = gam::MethodVariant::Paper;
+					g.setGroundOptions(o);
+				},
+				[&](const CGroundAwareOccupancyGrid& g) { paper.add(g); });
+			paperStages[k].add(paper);
+			if (decimation > 1)
+			{
+				timesOf<CGroundAwareOccupancyGrid>(
+					d, rounds, 0,
+					[&](CGroundAwareOccupancyGrid& g) {
+						auto o = g.groundOptions();
+						o.pipeline.projection.decimation = decimation;
+						g.setGroundOptions(o);
+					},
+					[&](const CGroundAwareOccupancyGrid& g) { decimated.add(g); });
+				decimatedStages[k].add(decimated);
+			}
+			hb[k].add(timesOf<CHeightBandOccupancyGrid>(d, rounds));
+			om[k].add(timesOf<COctoMapGrid2D>(d, 1));
+		}
+		for (size_t k = 0; k < D; k++)
+		{
+			const HeightBandSplit hs = heightBandSplit(g_data[k], roundsFor(g_data[k]));
+			hbConvert[k].add(hs.convert);
+			hbInsert[k].add(hs.insert);
+			hbPlain[k].add(hs.plainLoop);
+		}
+	}
+
 	std::printf("\nCPU: %s (one core per map; compare within a row)\n", cpuName().c_str());
+	if (runs > 1) std::printf("Every figure: the median of %d runs' figures.\n", runs);
 	std::printf(
 		"\n| data | frames | px/frame | ground_aware median / p95 ms | height_band median / p95 ms | octomap median / "
 		"p95 ms | height_band / ground_aware | octomap / ground_aware |\n|---|---|---|---|---|---|---|---|\n");
-	for (size_t k = 0; k < g_data.size(); k++)
+	for (size_t k = 0; k < D; k++)
 	{
 		const Dataset& d = g_data[k];
-		const int rounds = roundsFor(d);
-		const auto ga = timesOf<CGroundAwareOccupancyGrid>(
-			d, rounds, 0, {}, [&](const CGroundAwareOccupancyGrid& g) { stages[k].add(g); });
-		timesOf<CGroundAwareOccupancyGrid>(
-			d, rounds, 0,
-			[](CGroundAwareOccupancyGrid& g) {
-				auto o = g.groundOptions();
-				o.pipeline.ism.model = gam::MethodVariant::Paper;
-				o.pipeline.rrt.variant = gam::MethodVariant::Paper;
-				g.setGroundOptions(o);
-			},
-			[&](const CGroundAwareOccupancyGrid& g) { paperStages[k].add(g); });
-		if (decimation > 1)
-			timesOf<CGroundAwareOccupancyGrid>(
-				d, rounds, 0,
-				[&](CGroundAwareOccupancyGrid& g) {
-					auto o = g.groundOptions();
-					o.pipeline.projection.decimation = decimation;
-					g.setGroundOptions(o);
-				},
-				[&](const CGroundAwareOccupancyGrid& g) { decimatedStages[k].add(g); });
-		const auto hb = timesOf<CHeightBandOccupancyGrid>(d, rounds);
-		const auto om = timesOf<COctoMapGrid2D>(d, 1);
-		const double mga = quantile(ga, 0.5), mhb = quantile(hb, 0.5), mom = quantile(om, 0.5);
-		groundAwareMedian[k] = mga;
 		std::printf(
 			"| %s | %zu | %zux%zu | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.1fx | %.1fx |\n", d.name.c_str(),
 			d.frames.size(), size_t(d.frames[0].depth->rangeImage.cols()), size_t(d.frames[0].depth->rangeImage.rows()),
-			mga, quantile(ga, 0.95), mhb, quantile(hb, 0.95), mom, quantile(om, 0.95), mhb / mga, mom / mga);
+			ga[k].median(), ga[k].p95(), hb[k].median(), hb[k].p95(), om[k].median(), om[k].p95(),
+			medianRatio(hb[k], ga[k]), medianRatio(om[k], ga[k]));
 	}
 
 	std::printf(
 		"\nground_aware per stage (the map's own timers), default and paper mode, median / p95 ms (camera: the "
 		"model the map took the frames for):\n\n| data | camera | 2.5D projection | 3-sigma filter + IDW | RRT-GPD | "
 		"ISM | missing floor | grid update | whole frame |\n|---|---|---|---|---|---|---|---|---|\n");
-	auto mp = [](const std::vector<double>& v) {
+	auto mp = [](const Figure& f) {
 		char b[64];
-		std::snprintf(b, sizeof b, "%.3f / %.3f", quantile(v, 0.5), quantile(v, 0.95));
+		std::snprintf(b, sizeof b, "%.3f / %.3f", f.median(), f.p95());
 		return std::string(b);
 	};
 	const std::string decimatedLabel = " (decimation " + std::to_string(decimation) + ")";
 	for (const auto* series : {&stages, &paperStages, &decimatedStages})
-		for (size_t k = 0; k < g_data.size(); k++)
+		for (size_t k = 0; k < D; k++)
 		{
 			if (series == &decimatedStages && decimation == 1) break;
-			const StageSeries& t = (*series)[k];
+			const StageFigures& t = (*series)[k];
 			const char* camera = series == &paperStages ? "-" : gam::kCameraModelNames[int(t.camera)];
 			std::printf(
 				"| %s%s | %s | %s | %s | %s | %s | %s | %s | %s |\n", g_data[k].name.c_str(),
@@ -406,14 +478,10 @@ int main(int argc, char** argv)
 		"map does), and the same band as a plain loop over the pixels (no map; see heightBandSplit):\n\n| data | "
 		"convertTo2DScan | scan insertion | plain loop | ground_aware median | plain loop / ground_aware "
 		"|\n|---|---|---|---|---|---|\n");
-	for (size_t k = 0; k < g_data.size(); k++)
-	{
-		const HeightBandSplit hs = heightBandSplit(g_data[k], roundsFor(g_data[k]));
+	for (size_t k = 0; k < D; k++)
 		std::printf(
-			"| %s | %s | %s | %s | %.2f | %.2fx |\n", g_data[k].name.c_str(), mp(hs.convert).c_str(),
-			mp(hs.insert).c_str(), mp(hs.plainLoop).c_str(), groundAwareMedian[k],
-			quantile(hs.plainLoop, 0.5) / groundAwareMedian[k]);
-	}
+			"| %s | %s | %s | %s | %.2f | %.2fx |\n", g_data[k].name.c_str(), mp(hbConvert[k]).c_str(),
+			mp(hbInsert[k]).c_str(), mp(hbPlain[k]).c_str(), ga[k].median(), medianRatio(hbPlain[k], ga[k]));
 
 	if (fullOctomapFrames > 0)
 	{
@@ -426,11 +494,11 @@ int main(int argc, char** argv)
 			fullOctomapFrames);
 		for (size_t k = 0; k < g_data.size(); k++)
 		{
-			const auto om = timesOf<COctoMapGrid2D>(
+			const auto full = timesOf<COctoMapGrid2D>(
 				g_data[k], 1, size_t(fullOctomapFrames), [](COctoMapGrid2D& m) { m.octoOptions.decimation = 1; });
 			std::printf(
-				"| %s | %.1f / %.1f | %.2f | %.0fx |\n", g_data[k].name.c_str(), quantile(om, 0.5), quantile(om, 0.95),
-				groundAwareMedian[k], quantile(om, 0.5) / groundAwareMedian[k]);
+				"| %s | %.1f / %.1f | %.2f | %.0fx |\n", g_data[k].name.c_str(), quantile(full, 0.5),
+				quantile(full, 0.95), ga[k].median(), quantile(full, 0.5) / ga[k].median());
 		}
 	}
 	return 0;
