@@ -535,6 +535,40 @@ void MissingFloorDetector::compute(
 			else
 				judgeOne(c);
 		};
+		if (listEmpty && img.is_depth)
+		{
+			// judgeRay() and countRay() written out for a depth image's listed
+			// pixels outside the statistics rows (prev stays 0 there, no ray is
+			// counted, the depth is the expected range): one loop, no calls.
+			const double beyondMargin = m_params.beyond_margin;
+			for (int i = 0; i < candidates; i++)
+			{
+				const int c = emptyCols[i];
+				float tf, cxf, cyf;
+				if (wholeRow)
+				{
+					tf = T[c];
+					cxf = CX[c];
+					cyf = CY[c];
+				}
+				else
+					rays.meet(fyRow[c], fzRow[c], tf, cxf, cyf);
+				const double t = tf;
+				if (!(t > 0) || t > maxRange || !(cxf >= 0.f && cyf >= 0.f)) continue;
+				const int cx = int(cxf), cy = int(cyf);
+				if (cx >= g.nx || cy >= g.ny) continue;
+				const uint16_t v = raw[c];
+				if (v == 0 && fxBaseline > 0 &&
+					(missing::outsideSecondImager(c, t, fxBaseline) || hiddenFromSecondImager(c, t)))
+					continue;
+				if (v != 0 && !(v > rawInRange && double(v) * units > t + beyondMargin)) continue;
+				emptyCount++;
+				const uint32_t cell = uint32_t(g.index(cx, cy));
+				if (m_empty[cell] == 0) m_touched.push_back(cell);
+				if (m_empty[cell] < 65535) m_empty[cell]++;
+			}
+			continue;
+		}
 		if (listEmpty)
 		{
 			// (prev stays 0 outside the statistics rows: countRay() returns 0 there.)
