@@ -179,7 +179,8 @@ double quantile(std::vector<double> v, double q)
 }
 
 // One printed figure over the summary's runs: each run's median and p95 (of
-// its frames), and the median of those over the runs.
+// its frames), and the median of those over the runs (quantile(), so for an
+// even number of runs the upper of the two middle ones).
 struct Figure
 {
 	std::vector<double> q50, q95;
