@@ -107,6 +107,43 @@ void run(
 }
 
 uint32_t cellOf(int ix, int iy) { return uint32_t(iy * 20 + ix); }
+
+/** The floor as run()'s camera sees it in a range image (MRPT's
+ * range_is_depth = false: each pixel the distance along its ray, in mm): the
+ * ray (1, a, b) of pixel (r, c), a = (19.5 - r) / 80 and b = (19.5 - c) / 80,
+ * meets the floor 1 m down at depth 1 m and range sqrt(1 + a^2 + b^2) m. */
+std::vector<uint16_t> floorRanges()
+{
+	std::vector<uint16_t> range(size_t(kSize * kSize));
+	for (int r = 0; r < kSize; r++)
+		for (int c = 0; c < kSize; c++)
+		{
+			const double a = (19.5 - r) / 80, b = (19.5 - c) / 80;
+			range[size_t(r * kSize + c)] = uint16_t(std::lround(1000 * std::sqrt(1 + a * a + b * b)));
+		}
+	return range;
+}
+
+/** run()'s camera and grid on a range image, with the detector's range
+ * maxRange. */
+void runRangeImage(const std::vector<uint16_t>& range, Result& out, MissingFloorParams p, double maxRange)
+{
+	PinholeIntrinsics K;
+	K.width = K.height = kSize;
+	K.fx = K.fy = 80;
+	K.cx = K.cy = 19.5;
+	const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+	SensorFrame frame = depthFrame(range, K, R, kH);
+	frame.image.is_depth = false;
+	GridGeometry g;
+	g.x_min = g.y_min = -0.5;
+	g.resolution = 0.05;
+	g.nx = g.ny = 20;
+	DepthProjector proj;
+	const std::vector<VoxelClass> classes = seenFloorClasses(frame, g, out.grid, proj);
+	out.det.setParams(p);
+	out.det.compute(frame, proj, 1, maxRange, Plane{}, out.grid, classes, out.stats);
+}
 }  // namespace
 
 TEST(MissingFloor, EmptyCellChance)
@@ -580,5 +617,94 @@ TEST(MissingFloor, DropoutRateIsCountedPerRangeBinAlongARow)
 		// Each dark pixel has returning neighbours: 99 pairs after an empty
 		// ray (the next pixel of the row), none of them both empty.
 		EXPECT_EQ(det.neighbourDropoutRate(), 0.0) << turn;
+	}
+}
+
+TEST(MissingFloor, ARangeImageIsJudgedByTheRangeAlongEachRay)
+{
+	// A range image (floorRanges()): every ray meets the floor at depth 1 m,
+	// at range sqrt(1 + (u^2 + v^2) / 6400) m with u = 19.5 - r, v = 19.5 - c
+	// (half-integers). What the detector compares with the range, the bins and
+	// the margin below the floor, must be that range, not the depth.
+	MissingFloorParams every;
+	every.stats_row_step = 1;
+
+	// 1. A range of 1.02 m judges the rays with u^2 + v^2 <= (1.02^2 - 1) x
+	// 6400 = 258.56 (a depth image would judge all 1600 at 1 m). Per |u| =
+	// 0.5, 1.5, ..., the |v| <= sqrt(258.56 - u^2): 16.07, 16.01, 15.88,
+	// 15.69, 15.44, 15.11, 14.71, 14.22, 13.65, 12.97, 12.18, 11.24, 10.12,
+	// 8.74, 6.95, 4.28 (none from |u| = 16.5), i.e. 16, 16, 16, 16, 15, 15,
+	// 15, 14, 14, 13, 12, 11, 10, 9, 7, 4 half-integers: 203 per quadrant,
+	// 812 rays. (The nearest u^2 + v^2 on either side, 254.5 and 260.5, are
+	// 1.01969 and 1.02015 m: far from 1.02 m in float.)
+	EXPECT_EQ(16 + 16 + 16 + 16 + 15 + 15 + 15 + 14 + 14 + 13 + 12 + 11 + 10 + 9 + 7 + 4, 203);
+	{
+		Result res;
+		runRangeImage(floorRanges(), res, every, 1.02);
+		EXPECT_EQ(res.stats.rays, 812u);
+		EXPECT_EQ(res.stats.empty_rays, 0u);
+	}
+
+	// 2. A return beyond the range is no floor only beyond the floor's range
+	// plus beyond_margin (0.10 m). 1.110 m at the centre pixel (19, 19),
+	// range sqrt(1 + 0.5 / 6400) = 1.000039 m: beyond 1.100039, empty. 1.110 m
+	// at pixel (11, 6), u = 8.5, v = 13.5, u^2 + v^2 = 72.25 + 182.25 = 254.5,
+	// range sqrt(1 + 254.5 / 6400) = 1.019689 m: within 1.119689, not empty
+	// (against its depth, 1 + 0.10 < 1.110, it would be). Both pixels lie in
+	// statistics rows with every row one, in other rows with every 4th
+	// (rows 0, 4, ..., 36: rays counted there only, u = 19.5, 15.5, 11.5,
+	// 7.5, 3.5, 0.5, 4.5, 8.5, 12.5, 16.5, 2 x (0 + 4 + 11 + 14 + 16 + 16 +
+	// 15 + 14 + 10 + 0) = 200 of them, from the list above).
+	for (int statsRows : {1, 4})
+	{
+		std::vector<uint16_t> range = floorRanges();
+		range[size_t(19 * kSize + 19)] = 1110;
+		range[size_t(11 * kSize + 6)] = 1110;
+		MissingFloorParams p;
+		p.stats_row_step = statsRows;
+		Result res;
+		runRangeImage(range, res, p, 1.02);
+		EXPECT_EQ(res.stats.rays, statsRows == 1 ? 812u : 200u) << statsRows;
+		EXPECT_EQ(res.stats.empty_rays, 1u) << statsRows;
+		// The centre pixel meets the floor at x = y = 0.5 / 80 = 0.00625 m:
+		// cell floor((0.00625 + 0.5) / 0.05) = 10 on both axes.
+		EXPECT_EQ(res.det.emptyRays(cellOf(10, 10)), 1) << statsRows;
+	}
+
+	// 3. The dropout rate per range bin (1.0101 m, 4.5 m range: all 1600 rays
+	// judged): bin 0 holds u^2 + v^2 < (1.0101^2 - 1) x 6400 = 129.93: per |u|
+	// = 0.5 ... 10.5, |v| < 11.39, 11.30, 11.12, 10.85, 10.47, 9.98, 9.36,
+	// 8.58, 7.59, 6.30, 4.44, i.e. 11, 11, 11, 11, 10, 10, 9, 9, 8, 6, 4: 100
+	// per quadrant, 400 rays; bin 1 the other 1200. Row 19 (u = 0.5) dark:
+	// |v| >= 11.5 in bin 1, 9 a side, 18 rays; the other 22 in bin 0. (Each
+	// cell keeps the returns of its other rows: it is seen floor.)
+	EXPECT_EQ(11 + 11 + 11 + 11 + 10 + 10 + 9 + 9 + 8 + 6 + 4, 100);
+	{
+		std::vector<uint16_t> range = floorRanges();
+		for (int c = 0; c < kSize; c++) range[size_t(19 * kSize + c)] = 0;
+		MissingFloorParams p = every;
+		p.range_bin = 1.0101;
+		Result res;
+		runRangeImage(range, res, p, 4.5);
+		EXPECT_EQ(res.stats.rays, 1600u);
+		EXPECT_EQ(res.stats.empty_rays, 40u);
+		EXPECT_NEAR(res.det.dropoutRate(1.0), 22.0 / 400.0, 1e-12);    // 0.055
+		EXPECT_NEAR(res.det.dropoutRate(1.02), 18.0 / 1200.0, 1e-12);  // 0.015
+	}
+
+	// 4. A dark hole, 8 x 8 pixels at rows and columns 16-23 (cells 9 and 10
+	// on both axes, 16 rays each), whichever rows are statistics rows.
+	for (int statsRows : {1, 3, 4})
+	{
+		std::vector<uint16_t> range = floorRanges();
+		for (int r = 16; r < 24; r++)
+			for (int c = 16; c < 24; c++) range[size_t(r * kSize + c)] = 0;
+		MissingFloorParams p;
+		p.stats_row_step = statsRows;
+		Result res;
+		runRangeImage(range, res, p, 4.5);
+		EXPECT_EQ(res.stats.empty_rays, 64u) << statsRows;
+		for (int ix : {9, 10})
+			for (int iy : {9, 10}) EXPECT_EQ(res.det.emptyRays(cellOf(ix, iy)), 16) << statsRows;
 	}
 }
