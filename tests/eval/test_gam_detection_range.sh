@@ -14,7 +14,9 @@
 # - --rrt-seed 7 (on the approach run): the mapper's config_used.ini has
 #   random_seed=7, the CSV names it;
 # - --help exits 0; a bad option, a missing build, --objects matching nothing
-#   and a bad --rrt-seed exit 2 with one error line; --from re-reads detections.csv.
+#   and a bad --rrt-seed exit 2 with one error line; --from re-reads detections.csv;
+# - --cell-phases 2 --seeds 2: seed 2's scene shifts the robot and the hole by 2.5 cm;
+#   --cell-phases 0 exits 2.
 # usage: test_gam_detection_range.sh BUILD_DIR REPO
 set -euo pipefail
 build="$1" repo="$2"
@@ -81,6 +83,22 @@ awk -v v="$ga" 'BEGIN { exit !(v + 0 >= 1.0 && v + 0 <= 5.0) }' || fail "approac
 "$tool" --from "$w/single/detections.csv" --commit smoke >"$w/from.txt" || fail "--from"
 cmp -s <(grep '^| hole_' "$w/single.txt") <(grep '^| hole_' "$w/from.txt") || fail "--from gives other tables"
 
+# Cell phases: with --cell-phases 2, seed s shifts the robot and the object by ((s - 1) mod 2) x
+# 5 cm / 2: seed 1 by 0, seed 2 by 2.5 cm. A 10 cm hole at 1.0 m from the camera (0.1 m ahead of
+# the robot) has its centre at 0.1 + 1.0 + 0.05 = 1.15 m, and 1.175 m with the shift.
+"$tool" --build "$build" --maps ground_aware --modes single --objects '^hole_0\.10x0\.05$' --ranges "1.0" \
+	--seeds 2 --cell-phases 2 --out "$w/phase" --commit smoke >"$w/phase.txt" 2>"$w/phase.err" ||
+	{ cat "$w/phase.err"; fail "--cell-phases 2 run failed"; }
+for sd_shift_x in "1 0.0000 1.1500" "2 0.0250 1.1750"; do
+	read -r sd shift x <<<"$sd_shift_x"
+	sc="$w/phase/single/hole_0.10x0.05/r1.00_s$sd/s.scene"
+	grep -qx "path waypoints=$shift,0,0 frames=1" "$sc" || { cat "$sc"; fail "seed $sd: robot at x = $shift"; }
+	grep -q "^hole id=1 name=obj shape=rect x=$x y=0 " "$sc" || { cat "$sc"; fail "seed $sd: hole centre at $x"; }
+	grep -q "^hole_0.10x0.05,single,$sd,.*,$shift," "$w/phase/detections.csv" ||
+		fail "seed $sd: detections.csv cell_phase_m $shift"
+done
+grep -qF "seed 1: 0.00 cm, seed 2: 2.50 cm." "$w/phase.txt" || fail "the phases line"
+
 # Gaps, from a detections.csv written by hand (no runs): a 15 x 5 cm hole (limit 0.15 * 0.8 /
 # 0.03 = 4.00 m) marked by 3, 1 and 2 of 3 seeds at 1, 2 and 3 m: the majority reaches 3.00 m
 # with a gap at 2.00 m, so every range is marked only up to 1.00 m, and issue #27's verdict
@@ -115,6 +133,8 @@ set +e
 [[ $? -eq 2 ]] && grep -q "matches no object" "$w/err" || fail "--objects matching nothing"
 "$tool" --seeds 0 2>"$w/err"
 [[ $? -eq 2 ]] || fail "--seeds 0 accepted"
+"$tool" --cell-phases 0 2>"$w/err"
+[[ $? -eq 2 ]] && grep -q "cell-phases takes a whole number" "$w/err" || fail "--cell-phases 0 accepted"
 "$tool" --rrt-seed x 2>"$w/err"
 [[ $? -eq 2 ]] && grep -q "rrt-seed takes a whole number" "$w/err" || fail "--rrt-seed x accepted"
 echo "PASS"
