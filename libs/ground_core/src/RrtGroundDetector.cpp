@@ -309,16 +309,8 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 		out.fill_nodes = out.nodes.size() - treeNodes;
 		if (out.fill_nodes)
 		{
-			// Fit again with the filled patches (the ground plane holds the
-			// seed either way). Its refit starts from the ground plane just
-			// found, not again from the seed's window: the filled patches add
-			// nodes off that plane, and a window tilted by a stereo camera's
-			// correlated noise (2.2 deg, 0.7 m ahead of a D435) led the refit
-			// onto a 10 cm step's lower level, densely filled 2.6-3.6 m ahead,
-			// where the first fit had converged on the floor: a plane tilted
-			// 2.9 deg, 6 cm above the floor under the robot, 9 % of the
-			// frame's floor occupied (gam-detection-range, benchmark.md).
-			fitPlanes(out, &ground);
+			// Fit again with the filled patches (the ground plane holds the seed either way).
+			fitPlanes(out);
 		}
 	}
 	out.status = out.planes.empty() ? GroundDetection::Status::NoConsensus : GroundDetection::Status::Ok;
@@ -666,16 +658,14 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 }
 
 bool RrtGroundDetector::groundFromSeed(
-	const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp, const Plane* start)
+	const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp)
 {
 	// pts are the nodes in order: pts[0] is the seed. The nodes' noise about
 	// the seed's local plane (sigma = 1.4826 x the median absolute distance
 	// of those within the inlier distance) sets a tight band, 3 sigma + the
 	// cell quantisation (see noiseBand); the plane is refitted (total least
 	// squares) to the nodes inside that band, which then holds the nodes the
-	// better plane brings in, until the set stops changing (starting from
-	// `start` instead where given: the refit after the patches are filled
-	// starts from the plane the first fit found, see detect()). Refitting to all
+	// better plane brings in, until the set stops changing. Refitting to all
 	// nodes within the 2.5 cm instead let the foot of a wide ramp (its first
 	// 25 cm at 6 deg) tilt the floor toward it, which took in more of it.
 	Plane pl = out.nodes.front().local;
@@ -687,9 +677,6 @@ bool RrtGroundDetector::groundFromSeed(
 	}
 	if (m_absDist.size() < 3) return false;
 	const double band = noiseBand(rp.inlier_distance);
-	// (The band stays the one measured about the seed's window; only the
-	// refit's start moves.)
-	if (start) pl = *start;
 	size_t last = 0;
 	for (int it = 0; it < 20; it++)
 	{
@@ -817,7 +804,7 @@ void RrtGroundDetector::dropCreaseNodes(
 	refitToInliers(pts, rp);
 }
 
-void RrtGroundDetector::fitPlanes(GroundDetection& out, const Plane* groundStart)
+void RrtGroundDetector::fitPlanes(GroundDetection& out)
 {
 	// RANSAC over the node centres gives the ground plane; further RANSAC rounds
 	// over the remaining nodes give ramps and other ground patches that the tree
@@ -878,7 +865,7 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out, const Plane* groundStart
 		// seed tilted onto them. So it grows from the seed's own local plane
 		// (groundFromSeed). If that plane lacks the support, the largest
 		// consensus.
-		bool found = k == 0 && m_params.variant != MethodVariant::Paper && groundFromSeed(out, pts, rp, groundStart);
+		bool found = k == 0 && m_params.variant != MethodVariant::Paper && groundFromSeed(out, pts, rp);
 		if (!found) found = fitPlaneRansac(pts, rp, m_rng, m_ransac, m_ransacInliers);
 		if (!found) break;
 		if (k > 0) keepLargestCluster(pts, rp);

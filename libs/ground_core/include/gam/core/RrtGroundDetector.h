@@ -338,16 +338,11 @@ class RrtGroundDetector
 	void growTree(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
 	void growTreePaper(const ElevationGrid& grid, const GroundNode& seed, GroundDetection& out);
 	std::vector<std::pair<float, uint32_t>> m_candidates;  ///< paper fallback: (distance^2, node)
-	/** The planes of out.nodes, from scratch (earlier planes and node labels
-	 * dropped); the ground plane's refit starts from `groundStart` if given
-	 * (see groundFromSeed). */
-	void fitPlanes(GroundDetection& out, const Plane* groundStart = nullptr);
-	/** The ground plane grown from the seed's local plane, or from `start`
-	 * (see fitPlanes); false if it has fewer than rp.min_inliers nodes. Into
-	 * m_ransac. */
-	bool groundFromSeed(
-		const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp,
-		const Plane* start);
+	/** The planes of out.nodes, from scratch (earlier planes and node labels dropped). */
+	void fitPlanes(GroundDetection& out);
+	/** The ground plane grown from the seed's local plane (see fitPlanes);
+	 * false if it has fewer than rp.min_inliers nodes. Into m_ransac. */
+	bool groundFromSeed(const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
 	/** Keeps, of m_ransac's inliers, the largest group linked by steps of at
 	 * most d_n, and refits its plane (see fitPlanes). */
 	void keepLargestCluster(const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
