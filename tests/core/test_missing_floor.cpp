@@ -79,10 +79,13 @@ std::vector<VoxelClass> seenFloorClasses(
 }
 
 /** Runs the projector, the 2.5D map, hand-made classes (every cell with
- * samples is Ground) and the detector on `scene`. The grid is 20 x 20 cells
- * from (-0.5, -0.5): the image sees only its middle 10 x 10 cells. */
-void run(
-	const Scene& scene, Result& out, MissingFloorParams p = {}, double baseline = 0, const PatchSupport& patches = {})
+ * samples is Ground) and the detector (range maxRange) on `values`: depths,
+ * or ranges along the rays (MRPT's range_is_depth = false) if !isDepth, from
+ * a 40 x 40 camera 1 m above the floor looking straight down. The grid is 20
+ * x 20 cells from (-0.5, -0.5): the image sees only its middle 10 x 10 cells. */
+void runCamera(
+	const std::vector<uint16_t>& values, bool isDepth, double maxRange, Result& out, const MissingFloorParams& p,
+	double baseline = 0, const PatchSupport& patches = {})
 {
 	PinholeIntrinsics K;
 	K.width = K.height = kSize;
@@ -90,7 +93,8 @@ void run(
 	K.cx = K.cy = 19.5;
 	// Pitch 90 deg (nose down): sensor +X -> world -Z, +Y -> +Y, +Z -> +X.
 	const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-	const SensorFrame frame = depthFrame(scene.depth, K, R, kH);
+	SensorFrame frame = depthFrame(values, K, R, kH);
+	frame.image.is_depth = isDepth;
 
 	GridGeometry g;
 	g.x_min = g.y_min = -0.5;
@@ -99,11 +103,18 @@ void run(
 	DepthProjector proj;
 	const std::vector<VoxelClass> classes = seenFloorClasses(frame, g, out.grid, proj);
 
-	Plane floor;           // z = 0
-	p.stats_row_step = 1;  // every row, for the hand counts below
 	out.det.setParams(p);
 	out.det.setSecondImagerBaseline(baseline);
-	out.det.compute(frame, proj, 1, 4.5, floor, out.grid, classes, out.stats, patches);
+	out.det.compute(frame, proj, 1, maxRange, Plane{} /* z = 0 */, out.grid, classes, out.stats, patches);
+}
+
+/** runCamera() on the depth image `scene`, range 4.5 m, every row a
+ * statistics row (for the hand counts below). */
+void run(
+	const Scene& scene, Result& out, MissingFloorParams p = {}, double baseline = 0, const PatchSupport& patches = {})
+{
+	p.stats_row_step = 1;
+	runCamera(scene.depth, true, 4.5, out, p, baseline, patches);
 }
 
 uint32_t cellOf(int ix, int iy) { return uint32_t(iy * 20 + ix); }
@@ -122,27 +133,6 @@ std::vector<uint16_t> floorRanges()
 			range[size_t(r * kSize + c)] = uint16_t(std::lround(1000 * std::sqrt(1 + a * a + b * b)));
 		}
 	return range;
-}
-
-/** run()'s camera and grid on a range image, with the detector's range
- * maxRange. */
-void runRangeImage(const std::vector<uint16_t>& range, Result& out, MissingFloorParams p, double maxRange)
-{
-	PinholeIntrinsics K;
-	K.width = K.height = kSize;
-	K.fx = K.fy = 80;
-	K.cx = K.cy = 19.5;
-	const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-	SensorFrame frame = depthFrame(range, K, R, kH);
-	frame.image.is_depth = false;
-	GridGeometry g;
-	g.x_min = g.y_min = -0.5;
-	g.resolution = 0.05;
-	g.nx = g.ny = 20;
-	DepthProjector proj;
-	const std::vector<VoxelClass> classes = seenFloorClasses(frame, g, out.grid, proj);
-	out.det.setParams(p);
-	out.det.compute(frame, proj, 1, maxRange, Plane{}, out.grid, classes, out.stats);
 }
 }  // namespace
 
@@ -640,7 +630,7 @@ TEST(MissingFloor, ARangeImageIsJudgedByTheRangeAlongEachRay)
 	EXPECT_EQ(16 + 16 + 16 + 16 + 15 + 15 + 15 + 14 + 14 + 13 + 12 + 11 + 10 + 9 + 7 + 4, 203);
 	{
 		Result res;
-		runRangeImage(floorRanges(), res, every, 1.02);
+		runCamera(floorRanges(), false, 1.02, res, every);
 		EXPECT_EQ(res.stats.rays, 812u);
 		EXPECT_EQ(res.stats.empty_rays, 0u);
 	}
@@ -663,7 +653,7 @@ TEST(MissingFloor, ARangeImageIsJudgedByTheRangeAlongEachRay)
 		MissingFloorParams p;
 		p.stats_row_step = statsRows;
 		Result res;
-		runRangeImage(range, res, p, 1.02);
+		runCamera(range, false, 1.02, res, p);
 		EXPECT_EQ(res.stats.rays, statsRows == 1 ? 812u : 200u) << statsRows;
 		EXPECT_EQ(res.stats.empty_rays, 1u) << statsRows;
 		// The centre pixel meets the floor at x = y = 0.5 / 80 = 0.00625 m:
@@ -685,7 +675,7 @@ TEST(MissingFloor, ARangeImageIsJudgedByTheRangeAlongEachRay)
 		MissingFloorParams p = every;
 		p.range_bin = 1.0101;
 		Result res;
-		runRangeImage(range, res, p, 4.5);
+		runCamera(range, false, 4.5, res, p);
 		EXPECT_EQ(res.stats.rays, 1600u);
 		EXPECT_EQ(res.stats.empty_rays, 40u);
 		EXPECT_NEAR(res.det.dropoutRate(1.0), 22.0 / 400.0, 1e-12);    // 0.055
@@ -702,7 +692,7 @@ TEST(MissingFloor, ARangeImageIsJudgedByTheRangeAlongEachRay)
 		MissingFloorParams p;
 		p.stats_row_step = statsRows;
 		Result res;
-		runRangeImage(range, res, p, 4.5);
+		runCamera(range, false, 4.5, res, p);
 		EXPECT_EQ(res.stats.empty_rays, 64u) << statsRows;
 		for (int ix : {9, 10})
 			for (int iy : {9, 10}) EXPECT_EQ(res.det.emptyRays(cellOf(ix, iy)), 16) << statsRows;
