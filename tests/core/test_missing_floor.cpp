@@ -698,3 +698,150 @@ TEST(MissingFloor, ARangeImageIsJudgedByTheRangeAlongEachRay)
 			for (int iy : {9, 10}) EXPECT_EQ(res.det.emptyRays(cellOf(ix, iy)), 16) << statsRows;
 	}
 }
+
+namespace
+{
+// A step down near the end of the camera's range: a camera 1 m above the
+// floor at the map's origin, 60 x 80 pixels, fx = 120, fy = 240, pitched
+// down by atan(1 / 2.2) (its centre row meets the floor 2.2 m ahead),
+// returning nothing beyond a depth of 2.75 m. From x = 2.0 m on, a pit 0.2
+// m deep and 0.6 m wide (|y| < 0.3 m), the floor on either side of it (where
+// the dropout rate of seen floor is measured at every range). A ray that passes
+// the edge meets the lower floor 1.2 times as far as it would have met the
+// upper one: only those that would have met it within 2.75 / 1.2 = 2.29 m
+// of depth (x up to 2.08 m) return, from x = 2.4 m on; the others are
+// empty. Every other column returns nothing anywhere (a camera that drops
+// half its pixels: q = 0.5 on seen floor, and after an empty pixel comes
+// a returning one). Around 2.2 m a row is 1 / (240 sin^2 24.4 deg) = 2.4 cm
+// of floor deep and a column 2.4 / 120 = 2.0 cm wide: a 5 cm cell holds
+// 2-3 rows of 2-3 columns, a few rays, and each alone is no evidence
+// (0.5^n > alpha = 1e-3 for n <= 9).
+constexpr double kStepEdge = 2.0, kStepDrop = 0.2, kStepH = 1.0, kStepRange = 2.75;
+
+struct StepScene
+{
+	PinholeIntrinsics K;
+	Eigen::Matrix3d R;
+	std::vector<uint16_t> depth;
+	GridGeometry g;
+};
+
+StepScene stepScene()
+{
+	StepScene s;
+	s.K.width = 80;
+	s.K.height = 60;
+	s.K.fx = 120;
+	s.K.fy = 240;
+	s.K.cx = 39.5;
+	s.K.cy = 29.5;
+	s.R = Eigen::AngleAxisd(std::atan2(kStepH, 2.2), Eigen::Vector3d::UnitY()).toRotationMatrix();
+	s.depth.assign(size_t(s.K.width * s.K.height), 0);
+	for (int r = 0; r < s.K.height; r++)
+		for (int c = 0; c < s.K.width; c += 2)
+		{
+			// The projector's ray of pixel (r, c): (1, -(c - cx) / fx, -(r - cy) / fy)
+			// in the sensor frame, depth 1 along it.
+			const Eigen::Vector3d ray = s.R * Eigen::Vector3d(1, -(c - s.K.cx) / s.K.fx, -(r - s.K.cy) / s.K.fy);
+			if (ray.z() >= 0) continue;
+			double t = kStepH / -ray.z();  // depth where the ray meets z = 0
+			if (t * ray.x() >= kStepEdge && std::abs(t * ray.y()) < 0.3)
+				t = (kStepH + kStepDrop) / -ray.z();  // past the edge: the pit's floor
+			if (t <= kStepRange) s.depth[size_t(r * s.K.width + c)] = uint16_t(std::lround(1000 * t));
+		}
+	s.g.x_min = -0.5;
+	s.g.y_min = -1.0;
+	s.g.resolution = 0.05;
+	s.g.nx = 100;
+	s.g.ny = 40;
+	return s;
+}
+
+/** Missing floor on the step scene: the ISM's classes as the map gives them
+ * (cells whose samples lie 0.1 m or more below the ground plane z = 0 are
+ * Drop, other seen cells Ground). */
+void runStep(const StepScene& s, Result& out, MissingFloorParams p)
+{
+	p.stats_row_step = 1;
+	const SensorFrame frame = depthFrame(s.depth, s.K, s.R, kStepH);
+	DepthProjector proj;
+	std::vector<VoxelClass> classes = seenFloorClasses(frame, s.g, out.grid, proj);
+	for (size_t i = 0; i < s.g.cellCount(); i++)
+		if (out.grid.cell(i).count && out.grid.cell(i).z_max < -0.1) classes[i] = VoxelClass::Drop;
+	out.det.setParams(p);
+	out.det.compute(frame, proj, 1, kStepRange, Plane{}, out.grid, classes, out.stats);
+}
+
+uint32_t stepCell(double x, double y)
+{
+	return uint32_t(std::floor((y + 1.0) / 0.05) * 100 + std::floor((x + 0.5) / 0.05));
+}
+}  // namespace
+
+TEST(MissingFloor, IsStepShadowComparesTheGapWithTheEdgesShadow)
+{
+	// Edge 2.0 m from a sensor 1.0 m up, a surface 0.2 m down: the ray over
+	// the edge descends 1 / 2 per metre and meets it 0.2 * 2.0 / 1.0 = 0.4 m
+	// beyond the edge, at 2.4 m. Slack 0.1 m: a gap ending at 2.3-2.5 m is
+	// that shadow.
+	EXPECT_TRUE(missing::isStepShadow(2.0, 2.4, 0.2, 1.0, 0.1));
+	EXPECT_TRUE(missing::isStepShadow(2.0, 2.49, 0.2, 1.0, 0.1));
+	EXPECT_TRUE(missing::isStepShadow(2.0, 2.31, 0.2, 1.0, 0.1));
+	// 0.9 m of gap before that surface: longer than any shadow of the edge
+	// (a ramp down at grazing incidence); 0.1 m: shorter (no edge's shadow).
+	EXPECT_FALSE(missing::isStepShadow(2.0, 2.9, 0.2, 1.0, 0.1));
+	EXPECT_FALSE(missing::isStepShadow(2.0, 2.1, 0.2, 1.0, 0.1));
+	// The Kinect One case: 0.8 m up, a 0.10 m step 4.0 m ahead: 0.1 * 4.0 /
+	// 0.8 = 0.5 m of shadow, the lower floor from 4.5 m.
+	EXPECT_TRUE(missing::isStepShadow(4.0, 4.55, 0.1, 0.8, 0.1));
+	EXPECT_FALSE(missing::isStepShadow(4.0, 4.75, 0.1, 0.8, 0.1));
+	// No drop, no height, no edge: no shadow.
+	EXPECT_FALSE(missing::isStepShadow(2.0, 2.0, 0.0, 1.0, 0.1));
+	EXPECT_FALSE(missing::isStepShadow(2.0, 2.4, 0.2, 0.0, 0.1));
+	EXPECT_FALSE(missing::isStepShadow(0.0, 0.1, 0.2, 1.0, 0.1));
+}
+
+TEST(MissingFloor, AStepsShadowIsJudgedAsOneRegion)
+{
+	const StepScene s = stepScene();
+	// The shadow's cells that no returning ray meets, x 2.1-2.35 (the rays
+	// of x 2.0-2.08 return the lower floor), |y| < 0.25.
+	std::vector<uint32_t> shadow;
+	for (double x = 2.125; x < 2.35; x += 0.05)
+		for (double y = -0.225; y < 0.25; y += 0.05) shadow.push_back(stepCell(x, y));
+	{
+		Result res;
+		MissingFloorParams p;
+		p.step_shadows = false;
+		runStep(s, res, p);
+		// Half the rays on seen floor (a few rows straddle the shadow's cells).
+		for (double depth : {1.8, 2.2})
+		{
+			EXPECT_NEAR(res.det.dropoutRate(depth), 0.5, 0.02) << depth;
+		}
+		const double q = res.det.dropoutRate(2.2), p11 = res.det.neighbourDropoutRate();
+		EXPECT_GE(p11, 0.0);
+		EXPECT_LT(p11, 0.5);
+		// Each shadow cell alone: 3 to 9 empty rays, its chance q max(q,
+		// p11)^(n - 1) >= 0.48^9 = 0.0014 > alpha.
+		for (uint32_t c : shadow)
+		{
+			EXPECT_GE(res.det.emptyRays(c), 3) << c;
+			EXPECT_LE(res.det.emptyRays(c), 9) << c;
+			EXPECT_GT(missing::emptyCellChance(q, p11, res.det.emptyRays(c)), p.alpha) << c;
+			EXPECT_FALSE(res.det.isMissing(c)) << c;
+		}
+	}
+	Result res;
+	runStep(s, res, MissingFloorParams{});
+	// Together: the region's rays number at least 3 x 50 = 150, its chance at
+	// most 0.52^150 = 3e-43, the exponent taken (1 - p11) > 0.5 times as the
+	// rows may drop out together: 6e-22, against alpha / (cells with an
+	// empty ray, at most the grid's 4000) = 2.5e-7 at the least. Beyond it,
+	// the lower floor from 2.4 m: the shadow of the edge (isStepShadow).
+	EXPECT_EQ(res.stats.pooled_regions, 1u);
+	for (uint32_t c : shadow) EXPECT_TRUE(res.det.isMissing(c)) << c;
+	// The floors on either side are not missing.
+	EXPECT_FALSE(res.det.isMissing(stepCell(1.8, 0)));
+	EXPECT_FALSE(res.det.isMissing(stepCell(2.45, 0)));
+}

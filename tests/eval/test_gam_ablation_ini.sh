@@ -11,11 +11,11 @@ trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
 read -r -a labels <<< "$(bash "$tool" --labels)"
-[[ ${#labels[@]} -eq 21 ]] || fail "21 labels expected, got ${#labels[@]}: ${labels[*]}"
+[[ ${#labels[@]} -eq 22 ]] || fail "22 labels expected, got ${#labels[@]}: ${labels[*]}"
 [[ ${labels[0]} == ground_aware && ${labels[1]} == paper ]] || fail "the default and the paper first: ${labels[*]}"
 
 bash "$tool" "$src/config/ground-aware-mapper.ini" > "$tmp/ablation.ini"
-grep -qx "groundAwareGrid_count=21" "$tmp/ablation.ini" || fail "groundAwareGrid_count=21 missing"
+grep -qx "groundAwareGrid_count=22" "$tmp/ablation.ini" || fail "groundAwareGrid_count=22 missing"
 # The _groundOpts section of the grid labelled $1, as KEY=VALUE lines without comments.
 opts_of() {
 	local nn
@@ -40,6 +40,7 @@ opts_of no_range_smear | grep -qx "range_smear=false" || fail "no_range_smear"
 opts_of ground_aware | grep -qx "range_smear=true" || fail "ground_aware keeps range_smear"
 opts_of no_ground_offset | grep -qx "max_ground_offset=0" || fail "no_ground_offset"
 opts_of no_patch_memory | grep -qx "patch_memory=0" || fail "no_patch_memory"
+opts_of no_step_shadows | grep -qx "missing_floor_step_shadows=false" || fail "no_step_shadows"
 [[ $(opts_of ground_aware | grep -c "ism_model=paper") -eq 0 ]] || fail "ground_aware must not be the paper's ISM"
 # Each key appears once per section (a variant replaces the base's value).
 for l in "${labels[@]}"; do

@@ -23,6 +23,12 @@ double emptyCellChance(double q, double p11, int n)
 	return q * std::pow(next, n - 1);
 }
 
+bool isStepShadow(double edge, double far, double drop, double height, double slack)
+{
+	if (!(edge > 0) || !(drop > 0) || !(height > 0)) return false;
+	return std::abs((far - edge) * height - drop * edge) <= slack * height;
+}
+
 bool outsideSecondImager(int c, double z, double fxBaseline)
 {
 	// lround(c - d) < 0, i.e. c - d <= -0.5, without a libm call per pixel.
@@ -185,6 +191,7 @@ void MissingFloorDetector::compute(
 	{
 		m_empty.assign(N, 0);
 		m_mark.assign(N, 0);
+		m_logChance.assign(N, 0.f);
 		// Each list holds a cell at most once: reserved to that bound, so no
 		// later frame allocates (grown on demand, a pipeline that had seen only
 		// a few frames -- one per camera -- still grew them now and then).
@@ -604,6 +611,9 @@ void MissingFloorDetector::compute(
 
 	// 2. Candidate cells: nothing was seen there, and floor with the dropout
 	// rate measured at that range would rarely leave so many rays empty.
+	// Cells whose own rays are too few for that are weak candidates, judged
+	// together with the weak cells connected to them (step 3).
+	const bool pool = m_params.step_shadows;
 	const Eigen::Vector3d xAxis = R.col(0);
 	for (uint32_t cell : m_touched)
 	{
@@ -614,7 +624,16 @@ void MissingFloorDetector::compute(
 		if (std::abs(n.z()) < 1e-9) continue;
 		const Eigen::Vector3d pc(x, y, -(n.x() * x + n.y() * y + d) / n.z());
 		const double depth = img.is_depth ? (pc - s).dot(xAxis) : (pc - s).norm();
-		if (missing::emptyCellChance(dropoutRate(depth), m_p11, n_) > m_params.alpha) continue;
+		const double chance = missing::emptyCellChance(dropoutRate(depth), m_p11, n_);
+		if (chance > m_params.alpha)
+		{
+			if (pool && chance < 1.0)
+			{
+				m_mark[cell] = kWeak;
+				m_logChance[cell] = float(std::log(chance));
+			}
+			continue;
+		}
 		m_mark[cell] = kCandidate;
 		stats.candidates++;
 	}
@@ -629,14 +648,52 @@ void MissingFloorDetector::compute(
 		const double dx = g.cx(cx) - s.x(), dy = g.cy(cy) - s.y();
 		return dx * dx + dy * dy;
 	};
+	// Pooled evidence: a region of weak candidates is missing floor when the
+	// chance that floor leaves all of its rays empty is below alpha / (the
+	// cells judged): the product of its cells' chances, its exponent divided
+	// by the expected length of a run of empty rays along a row, 1 / (1 -
+	// p11), as the rows of a region may drop out together as the pixels of
+	// a row do. Only the shadow of a step down is judged so (stepShadow).
+	const double sensorHeight = n.dot(s) + d;
+	const double logAlphaPooled = std::log(m_params.alpha / double(std::max<size_t>(1, m_touched.size())));
+	// Whether the ray from the sensor through a gap to cell a (a surface
+	// below the ground plane, beyond the gap) is the shadow of a step down
+	// (missing::isStepShadow): back along the ray, the gap (no sample) must
+	// start at seen floor, the edge. A drop from a ramp or landing patch is
+	// judged against that patch, not the ground plane (no cell there is
+	// missing floor, see compute()).
+	const auto stepShadow = [&](double ux, double uy, int ax, int ay) {
+		const size_t a = g.index(ax, ay);
+		if (patches.applies(uint32_t(a))) return false;
+		const double drop = -(n.x() * g.cx(ax) + n.y() * g.cy(ay) + n.z() * double(grid.cell(a).z_max) + d);
+		if (!(drop > 0)) return false;
+		const double fx = g.cx(ax) - s.x(), fy = g.cy(ay) - s.y();
+		const double far = std::sqrt(fx * fx + fy * fy), len = std::sqrt(ux * ux + uy * uy);
+		const double slack = 2 * g.resolution;
+		for (int step = 1;; step++)
+		{
+			const double r = far - step * g.resolution;
+			// Stop once the gap is longer than any edge's shadow there.
+			if (r <= 0 || (far - r - slack) * sensorHeight > drop * r) return false;
+			const int bx = g.ix(s.x() + r * ux / len), by = g.iy(s.y() + r * uy / len);
+			if (!g.inside(bx, by)) return false;
+			const size_t b = g.index(bx, by);
+			if (classes[b] == VoxelClass::Ground) return missing::isStepShadow(r, far, drop, sensorHeight, slack);
+			// More of the lower surface, or the gap; anything else ends it.
+			if (grid.cell(b).count > 0 && classes[b] != VoxelClass::Drop) return false;
+		}
+	};
 	for (uint32_t seed : m_touched)
 	{
-		if (m_mark[seed] != kCandidate) continue;
+		const uint8_t kind = m_mark[seed];
+		if (kind != kCandidate && kind != kWeak) continue;
 		m_region.clear();
 		m_queue.clear();
 		m_queue.push_back(seed);
 		m_mark[seed] |= kVisited;
 		bool nearer = false, farther = false;
+		double logChance = 0;
+		int shadowRays = 0;  // rays of the region that are a step's shadow
 		for (size_t qi = 0; qi < m_queue.size(); qi++)
 		{
 			const uint32_t c = m_queue[qi];
@@ -657,9 +714,15 @@ void MissingFloorDetector::compute(
 						if (!g.inside(ax, ay)) break;
 						const size_t a = g.index(ax, ay);
 						if (a == c) continue;
-						if (classes[a] == VoxelClass::Ground)
+						// Beyond the gap, the floor, or (in a step's shadow) the
+						// surface below the step.
+						const bool floorBeyond = classes[a] == VoxelClass::Ground;
+						const bool stepBeyond = side > 0 && pool && !floorBeyond && classes[a] == VoxelClass::Drop &&
+												stepShadow(ux, uy, ax, ay);
+						if (floorBeyond || stepBeyond)
 						{
-							(side < 0 ? nearer : farther) = true;
+							(side < 0 ? nearer : farther) |= floorBeyond;
+							shadowRays += stepBeyond;
 							break;
 						}
 						if (grid.cell(a).count > 0 || m_empty[a] > 0) break;  // seen, or a ray came back empty
@@ -671,18 +734,29 @@ void MissingFloorDetector::compute(
 					const int ax = cx + dx, ay = cy + dy;
 					if (!g.inside(ax, ay)) continue;
 					const uint32_t a = uint32_t(g.index(ax, ay));
-					if (m_mark[a] == kCandidate)
+					if (m_mark[a] == kind)
 					{
 						m_mark[a] |= kVisited;
 						m_queue.push_back(a);
 					}
 				}
+			if (kind == kWeak) logChance += double(m_logChance[c]);
 		}
-		const bool bordered = nearer && farther;
+		// Beyond the gap, the lower surface of a step must be seen along
+		// several rays (as many as a cell needs empty ones), not in one noisy
+		// cell; a region of weak candidates is judged only as a step's shadow.
+		const bool stepBeyond = shadowRays >= m_params.min_rays;
+		const bool bordered = nearer && (stepBeyond || (farther && kind == kCandidate));
 		if (!bordered)
 		{
 			stats.unbordered++;
 			continue;
+		}
+		if (kind == kWeak)
+		{
+			const double next = std::clamp(m_p11, 0.0, 1.0 - 1e-9);
+			if (logChance * (1.0 - next) > logAlphaPooled) continue;
+			stats.pooled_regions++;
 		}
 		stats.regions++;
 		for (uint32_t c : m_region)

@@ -18,7 +18,9 @@
 // chance is below `alpha`. Missing cells are kept per connected region, and
 // only regions with floor seen in the frame next to them, along the rays,
 // both nearer to the sensor and farther away: a gap inside the floor, not the place where the
-// returns stop (a range cutoff) or start (the robot's own body).
+// returns stop (a range cutoff) or start (the robot's own body). The shadow
+// of a step down is a gap too: beyond it, a lower surface where the edge's
+// shadow ends; its cells are judged together (step_shadows).
 // Pure code: no MRPT, no I/O; no heap allocation per frame once sized.
 #pragma once
 
@@ -57,6 +59,14 @@ struct MissingFloorParams
 	 * rows of a 424-row frame are plenty); the empty rays of every row are
 	 * counted. A speed setting: 1 = every row. */
 	int stats_row_step = 4;
+	/** The shadow of a step down, judged as one region: cells with too few
+	 * empty rays to count alone (their chance above alpha) are judged
+	 * together with the connected ones, when beyond them lies a surface
+	 * below the ground where the edge's shadow on it ends
+	 * (missing::isStepShadow). Near the end of a camera's range, where the
+	 * floor drops out often and the rows are sparse, no cell of a step's
+	 * shadow holds enough rays alone; a region of them does. */
+	bool step_shadows = true;
 
 	template <class Self, class Visit>
 	static void forEachParam(Self& p, Visit&& visit)
@@ -80,6 +90,11 @@ struct MissingFloorParams
 		visit(
 			ParamInfo{"missing_floor_stats_rows", 1, 1000, "the dropout statistics use every n-th image row"},
 			p.stats_row_step);
+		visit(
+			ParamInfo{
+				"missing_floor_step_shadows", 0, 1,
+				"judge the shadow of a step down as one region (its cells have too few rays alone)"},
+			p.step_shadows);
 	}
 	/** Throws std::invalid_argument naming the parameter out of range. */
 	void validate() const;
@@ -87,15 +102,16 @@ struct MissingFloorParams
 
 struct MissingFloorStats
 {
-	size_t rays = 0;           ///< pixels whose ray meets the ground within range
-	size_t empty_rays = 0;     ///< of those, no return (or one far below the floor)
-	size_t candidates = 0;     ///< cells with no sample, enough empty rays, unlikely as dropout
-	size_t cells = 0;          ///< missing-floor cells (in regions bordering floor)
-	size_t regions = 0;        ///< their connected regions
-	size_t unbordered = 0;     ///< candidate regions dropped: no seen floor both before and beyond them
-	size_t blocking = 0;       ///< missing cells within block_range
-	size_t under_patches = 0;  ///< cells of bordered regions left out: a ramp or landing patch applies there
-	bool applied = false;      ///< the stage ran on this frame
+	size_t rays = 0;            ///< pixels whose ray meets the ground within range
+	size_t empty_rays = 0;      ///< of those, no return (or one far below the floor)
+	size_t candidates = 0;      ///< cells with no sample, enough empty rays, unlikely as dropout
+	size_t cells = 0;           ///< missing-floor cells (in regions bordering floor)
+	size_t regions = 0;         ///< their connected regions
+	size_t unbordered = 0;      ///< candidate regions dropped: no seen floor both before and beyond them
+	size_t pooled_regions = 0;  ///< regions kept on their weak candidates' evidence together
+	size_t blocking = 0;        ///< missing cells within block_range
+	size_t under_patches = 0;   ///< cells of bordered regions left out: a ramp or landing patch applies there
+	bool applied = false;       ///< the stage ran on this frame
 };
 
 namespace missing
@@ -114,6 +130,16 @@ double emptyCellChance(double q, double p11, int n);
  * edge, fx baseline / z pixels wide. Such a pixel returns nothing whatever
  * lies there. */
 bool outsideSecondImager(int c, double z, double fxBaseline);
+
+/** Whether a gap in the floor is the shadow of a step down: seen floor ends
+ * at the edge, `edge` from the sensor (2D), which is `height` above the
+ * floor; the gap ends where a surface `drop` below the floor is seen, `far`
+ * from the sensor. The ray over the edge descends height / edge per metre,
+ * so it meets that surface drop * edge / height beyond the edge: the gap is
+ * the step's shadow if far - edge is that long, within `slack` (sampling).
+ * A longer gap could be a ramp down seen at too grazing an angle to return
+ * anything; a shorter one is no edge's shadow. */
+bool isStepShadow(double edge, double far, double drop, double height, double slack);
 }  // namespace missing
 
 class MissingFloorDetector
@@ -176,10 +202,11 @@ class MissingFloorDetector
 	double neighbourDropoutRate() const { return m_p11; }
 
    private:
-	static constexpr uint8_t kCandidate = 1, kMissing = 2, kVisited = 4, kBlocking = 8;
+	static constexpr uint8_t kCandidate = 1, kMissing = 2, kVisited = 4, kBlocking = 8, kWeak = 16;
 	MissingFloorParams m_params;
-	std::vector<uint16_t> m_empty;  ///< per frame cell
-	std::vector<uint8_t> m_mark;    ///< per frame cell
+	std::vector<uint16_t> m_empty;   ///< per frame cell
+	std::vector<uint8_t> m_mark;     ///< per frame cell
+	std::vector<float> m_logChance;  ///< per weak candidate cell: log of its chance
 	std::vector<uint32_t> m_touched, m_cells, m_blocking, m_queue, m_region;
 	std::vector<uint32_t> m_binRays, m_binEmpty;
 	double m_p11 = -1;
