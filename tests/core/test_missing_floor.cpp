@@ -711,8 +711,9 @@ namespace
 // upper one: only those that would have met it within 2.75 / 1.2 = 2.29 m
 // of depth (x up to 2.08 m) return, from x = 2.4 m on; the others are
 // empty. Every other column returns nothing anywhere (a camera that drops
-// half its pixels: q = 0.5 on seen floor, and after an empty pixel comes
-// a returning one). Around 2.2 m a row is 1 / (240 sin^2 24.4 deg) = 2.4 cm
+// half its pixels: q = 0.5 on seen floor, and after an empty pixel comes a
+// returning one but where that one lies in the shadow, in a cell that also
+// holds floor samples: p11 small). Around 2.2 m a row is 1 / (240 sin^2 24.4 deg) = 2.4 cm
 // of floor deep and a column 2.4 / 120 = 2.0 cm wide: a 5 cm cell holds
 // 2-3 rows of 2-3 columns, a few rays, and each alone is no evidence
 // (0.5^n > alpha = 1e-3 for n <= 9).

@@ -662,20 +662,21 @@ void MissingFloorDetector::compute(
 	// start at seen floor, the edge. A drop from a ramp or landing patch is
 	// judged against that patch, not the ground plane (no cell there is
 	// missing floor, see compute()).
-	const auto stepShadow = [&](double ux, double uy, int ax, int ay) {
+	// (ex, ey: the ray's unit direction.)
+	const auto stepShadow = [&](double ex, double ey, int ax, int ay) {
 		const size_t a = g.index(ax, ay);
 		if (patches.applies(uint32_t(a))) return false;
 		const double drop = -(n.x() * g.cx(ax) + n.y() * g.cy(ay) + n.z() * double(grid.cell(a).z_max) + d);
 		if (!(drop > 0)) return false;
 		const double fx = g.cx(ax) - s.x(), fy = g.cy(ay) - s.y();
-		const double far = std::sqrt(fx * fx + fy * fy), len = std::sqrt(ux * ux + uy * uy);
+		const double far = std::sqrt(fx * fx + fy * fy);
 		const double slack = 2 * g.resolution;
 		for (int step = 1;; step++)
 		{
 			const double r = far - step * g.resolution;
 			// Stop once the gap is longer than any edge's shadow there.
 			if (r <= 0 || (far - r - slack) * sensorHeight > drop * r) return false;
-			const int bx = g.ix(s.x() + r * ux / len), by = g.iy(s.y() + r * uy / len);
+			const int bx = g.ix(s.x() + r * ex), by = g.iy(s.y() + r * ey);
 			if (!g.inside(bx, by)) return false;
 			const size_t b = g.index(bx, by);
 			if (classes[b] == VoxelClass::Ground) return missing::isStepShadow(r, far, drop, sensorHeight, slack);
@@ -718,7 +719,7 @@ void MissingFloorDetector::compute(
 						// surface below the step.
 						const bool floorBeyond = classes[a] == VoxelClass::Ground;
 						const bool stepBeyond = side > 0 && pool && !floorBeyond && classes[a] == VoxelClass::Drop &&
-												stepShadow(ux, uy, ax, ay);
+												stepShadow(ux / len, uy / len, ax, ay);
 						if (floorBeyond || stepBeyond)
 						{
 							(side < 0 ? nearer : farther) |= floorBeyond;
@@ -745,8 +746,8 @@ void MissingFloorDetector::compute(
 		// Beyond the gap, the lower surface of a step must be seen along
 		// several rays (as many as a cell needs empty ones), not in one noisy
 		// cell; a region of weak candidates is judged only as a step's shadow.
-		const bool stepBeyond = shadowRays >= m_params.min_rays;
-		const bool bordered = nearer && (stepBeyond || (farther && kind == kCandidate));
+		const bool lowerSurfaceBeyond = shadowRays >= m_params.min_rays;
+		const bool bordered = nearer && (lowerSurfaceBeyond || (farther && kind == kCandidate));
 		if (!bordered)
 		{
 			stats.unbordered++;

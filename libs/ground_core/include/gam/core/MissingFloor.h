@@ -102,12 +102,13 @@ struct MissingFloorParams
 
 struct MissingFloorStats
 {
-	size_t rays = 0;            ///< pixels whose ray meets the ground within range
-	size_t empty_rays = 0;      ///< of those, no return (or one far below the floor)
-	size_t candidates = 0;      ///< cells with no sample, enough empty rays, unlikely as dropout
-	size_t cells = 0;           ///< missing-floor cells (in regions bordering floor)
-	size_t regions = 0;         ///< their connected regions
-	size_t unbordered = 0;      ///< candidate regions dropped: no seen floor both before and beyond them
+	size_t rays = 0;        ///< pixels whose ray meets the ground within range
+	size_t empty_rays = 0;  ///< of those, no return (or one far below the floor)
+	size_t candidates = 0;  ///< cells with no sample, enough empty rays, unlikely as dropout
+	size_t cells = 0;       ///< missing-floor cells (in regions bordering floor)
+	size_t regions = 0;     ///< their connected regions
+	size_t unbordered =
+		0;  ///< candidate regions dropped: no seen floor before, or neither floor nor a step's lower surface beyond
 	size_t pooled_regions = 0;  ///< regions kept on their weak candidates' evidence together
 	size_t blocking = 0;        ///< missing cells within block_range
 	size_t under_patches = 0;   ///< cells of bordered regions left out: a ramp or landing patch applies there
