@@ -727,7 +727,12 @@ struct StepScene
 	GridGeometry g;
 };
 
-StepScene stepScene()
+/** The step scene with a pit `drop` deep (0: flat floor), every
+ * `dropEvery`-th column returning nothing (2: every other one); floor rays
+ * of columns arcFrom..arcTo - 1 whose depth is within `emptyArc` of the
+ * range's end return nothing either (as if the depth noise had carried them
+ * beyond it). */
+StepScene stepScene(double drop = kStepDrop, int dropEvery = 2, double emptyArc = 0, int arcFrom = 0, int arcTo = 0)
 {
 	StepScene s;
 	s.K.width = 80;
@@ -739,15 +744,17 @@ StepScene stepScene()
 	s.R = Eigen::AngleAxisd(std::atan2(kStepH, 2.2), Eigen::Vector3d::UnitY()).toRotationMatrix();
 	s.depth.assign(size_t(s.K.width * s.K.height), 0);
 	for (int r = 0; r < s.K.height; r++)
-		for (int c = 0; c < s.K.width; c += 2)
+		for (int c = 0; c < s.K.width; c++)
 		{
+			if (c % dropEvery == dropEvery - 1) continue;
 			// The projector's ray of pixel (r, c): (1, -(c - cx) / fx, -(r - cy) / fy)
 			// in the sensor frame, depth 1 along it.
 			const Eigen::Vector3d ray = s.R * Eigen::Vector3d(1, -(c - s.K.cx) / s.K.fx, -(r - s.K.cy) / s.K.fy);
 			if (ray.z() >= 0) continue;
 			double t = kStepH / -ray.z();  // depth where the ray meets z = 0
-			if (t * ray.x() >= kStepEdge && std::abs(t * ray.y()) < 0.3)
-				t = (kStepH + kStepDrop) / -ray.z();  // past the edge: the pit's floor
+			if (c >= arcFrom && c < arcTo && t > kStepRange - emptyArc) continue;
+			if (drop > 0 && t * ray.x() >= kStepEdge && std::abs(t * ray.y()) < 0.3)
+				t = (kStepH + drop) / -ray.z();  // past the edge: the pit's floor
 			if (t <= kStepRange) s.depth[size_t(r * s.K.width + c)] = uint16_t(std::lround(1000 * t));
 		}
 	s.g.x_min = -0.5;
@@ -761,7 +768,7 @@ StepScene stepScene()
 /** Missing floor on the step scene: the ISM's classes as the map gives them
  * (cells whose samples lie 0.1 m or more below the ground plane z = 0 are
  * Drop, other seen cells Ground). */
-void runStep(const StepScene& s, Result& out, MissingFloorParams p)
+void runStep(const StepScene& s, Result& out, MissingFloorParams p, double rangeEndMargin = 0)
 {
 	p.stats_row_step = 1;
 	const SensorFrame frame = depthFrame(s.depth, s.K, s.R, kStepH);
@@ -770,12 +777,22 @@ void runStep(const StepScene& s, Result& out, MissingFloorParams p)
 	for (size_t i = 0; i < s.g.cellCount(); i++)
 		if (out.grid.cell(i).count && out.grid.cell(i).z_max < -0.1) classes[i] = VoxelClass::Drop;
 	out.det.setParams(p);
+	out.det.setRangeEndMargin(rangeEndMargin);
 	out.det.compute(frame, proj, 1, kStepRange, Plane{}, out.grid, classes, out.stats);
 }
 
 uint32_t stepCell(double x, double y)
 {
 	return uint32_t(std::floor((y + 1.0) / 0.05) * 100 + std::floor((x + 0.5) / 0.05));
+}
+
+/** The pit's cells with centres from x = 2.125 m to below xEnd, |y| < 0.25 m. */
+std::vector<uint32_t> pitCells(double xEnd)
+{
+	std::vector<uint32_t> cells;
+	for (double x = 2.125; x < xEnd; x += 0.05)
+		for (double y = -0.225; y < 0.25; y += 0.05) cells.push_back(stepCell(x, y));
+	return cells;
 }
 }  // namespace
 
@@ -807,9 +824,7 @@ TEST(MissingFloor, AStepsShadowIsJudgedAsOneRegion)
 	const StepScene s = stepScene();
 	// The shadow's cells that no returning ray meets, x 2.1-2.35 (the rays
 	// of x 2.0-2.08 return the lower floor), |y| < 0.25.
-	std::vector<uint32_t> shadow;
-	for (double x = 2.125; x < 2.35; x += 0.05)
-		for (double y = -0.225; y < 0.25; y += 0.05) shadow.push_back(stepCell(x, y));
+	const std::vector<uint32_t> shadow = pitCells(2.35);
 	{
 		Result res;
 		MissingFloorParams p;
@@ -845,4 +860,103 @@ TEST(MissingFloor, AStepsShadowIsJudgedAsOneRegion)
 	// The floors on either side are not missing.
 	EXPECT_FALSE(res.det.isMissing(stepCell(1.8, 0)));
 	EXPECT_FALSE(res.det.isMissing(stepCell(2.45, 0)));
+}
+
+TEST(MissingFloor, AStepsShadowMayRunToTheEndOfTheRange)
+{
+	// The pit 0.5 m deep: a ray over the edge meets its floor (1 + 0.5) / 1
+	// = 1.5 times as deep as the upper floor, so only rays that would have met
+	// the upper floor within 2.75 / 1.5 = 1.83 m of depth could return from
+	// it; past the edge (depth 2.0 cos 24.4 deg + 1.0 sin 24.4 deg = 2.24 m)
+	// none does. The gap runs from the edge to where the upper floor itself
+	// leaves the range: depth 2.75 m, x = (2.75 - 0.413) / 0.911 = 2.57 m.
+	// Beside the pit the floor is seen out to there. A camera that drops
+	// every 4th column: q = 0.25 on seen floor, and the pixel after an empty
+	// one returns (p11 = 0).
+	const StepScene s = stepScene(0.5, 4);
+	const std::vector<uint32_t> shadow = pitCells(2.5);
+	{
+		// No surface beyond the gap closes it: without the rule, nothing.
+		Result res;
+		MissingFloorParams p;
+		p.step_shadows = false;
+		runStep(s, res, p);
+		for (uint32_t c : shadow) EXPECT_FALSE(res.det.isMissing(c)) << c;
+	}
+	Result res;
+	runStep(s, res, MissingFloorParams{}, 0.05);
+	EXPECT_NEAR(res.det.dropoutRate(2.2), 0.25, 0.02);
+	// With it: the gap's rays run through unseen cells to where the range
+	// ends (x = 2.57 m). Its cells nearer than the range's end less the
+	// margin (0.05 m: x < 2.51 m) have 3 or more empty rays (the pit's 2-3
+	// rows and 2-3 columns a cell), q^n <= 0.25^3 = 0.016 a cell, x e 7 =
+	// 19 as the region is a cluster picked among many: 0.30; some 70 of them:
+	// at most 0.30^70 = 1e-37, against alpha / (cells with an empty ray, at
+	// most the grid's 4000) = 2.5e-7. Each judged cell is missing floor (a
+	// cell the rows straddle gets 2 rays, and is not judged).
+	int judged = 0;
+	for (uint32_t c : shadow)
+		if (res.det.emptyRays(c) >= 3)
+		{
+			judged++;
+			EXPECT_TRUE(res.det.isMissing(c)) << c;
+		}
+	EXPECT_GE(judged, 60);
+	EXPECT_FALSE(res.det.isMissing(stepCell(1.8, 0)));
+	EXPECT_FALSE(res.det.isMissing(stepCell(2.3, 0.45)));
+}
+
+TEST(MissingFloor, TheRangesNoisyEndIsNoStepsShadow)
+{
+	// Flat floor. Rays of columns 30-49 (y from -0.2 to +0.2 m at 2.4 m)
+	// within 0.3 m of the range's end (depth 2.45-2.75 m, x = 2.24-2.57 m)
+	// return nothing: what depth noise of that size does at a hard range
+	// limit; the other columns see floor out to the end. Floor nearer, the
+	// range's end beyond: to the map, the same gap as a step's shadow 0.4 m
+	// wide (q = 0.25 besides, p11 = 0).
+	const StepScene s = stepScene(0.0, 4, 0.3, 30, 50);
+	const uint32_t arc = stepCell(2.4, 0.0);
+	{
+		// With a margin shorter than the arc, its near part (x < 2.51 m) is
+		// taken for a step's shadow that runs to the end of the range.
+		Result res;
+		runStep(s, res, MissingFloorParams{}, 0.05);
+		EXPECT_TRUE(res.det.isMissing(arc));
+		EXPECT_EQ(res.stats.range_end_regions, 1u);
+	}
+	// A margin of the arc's depth (0.3 m: three sigma of a depth noise of
+	// 0.1 m there): no cell of the arc is evidence, nothing is missing.
+	Result res;
+	runStep(s, res, MissingFloorParams{}, 0.3);
+	EXPECT_EQ(res.stats.cells, 0u);
+	EXPECT_FALSE(res.det.isMissing(arc));
+	// Neither is the floor seen beside it.
+	EXPECT_FALSE(res.det.isMissing(stepCell(2.4, 0.45)));
+}
+
+TEST(MissingFloor, AnArcAcrossTheViewIsNoStepsShadow)
+{
+	// The same empty arc across the whole image, as the range's end leaves
+	// it: no floor is seen at its depth (its cells beyond 2.5 m of depth
+	// fall in a range bin with no seen floor, whose dropout rate is 1, no
+	// evidence), even with a margin shorter than the arc.
+	const StepScene s = stepScene(0.0, 4, 0.3, 0, 80);
+	Result res;
+	runStep(s, res, MissingFloorParams{}, 0.05);
+	EXPECT_EQ(res.det.dropoutRate(2.6), 1.0);
+	EXPECT_EQ(res.stats.cells, 0u);
+	EXPECT_FALSE(res.det.isMissing(stepCell(2.4, 0.0)));
+}
+
+TEST(MissingFloor, DropoutsAtTheEndOfTheRangeAreNoStepsShadow)
+{
+	// The pit of AStepsShadowMayRunToTheEndOfTheRange seen by the camera
+	// that drops every other column (q = 0.5, 3-9 empty rays a cell). A
+	// cluster of empty cells that large turns up among dropping-out floor
+	// by chance: q^3 x e x 7 = 0.125 x 19 = 2.4 > 1 a cell. Its rays run to
+	// the end of the range all the same: nothing is marked.
+	const StepScene s = stepScene(0.5, 2);
+	Result res;
+	runStep(s, res, MissingFloorParams{}, 0.05);
+	for (double x = 2.125; x < 2.5; x += 0.05) EXPECT_FALSE(res.det.isMissing(stepCell(x, 0.025))) << x;
 }

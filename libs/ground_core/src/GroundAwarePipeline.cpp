@@ -223,6 +223,9 @@ const FrameResult& GroundAwarePipeline::process(
 	{
 		const double range = std::min<double>(frame.max_range, evidenceRange);
 		m_missing.setSecondImagerBaseline(noise.baseline);
+		m_missing.setRangeEndMargin(
+			m_params.ism.noise_sigmas *
+			std::hypot(noise.independent(range, frame.intrinsics.fx), noise.correlated(range, frame.intrinsics.fx)));
 		m_missing.compute(
 			frame, m_projector, m_params.projection.decimation, range, m_result.detection.plane(), m_grid,
 			m_ism.classes(), m_result.missing, m_ism.patchSupport(m_grid.geometry().nx));

@@ -195,7 +195,12 @@ void MissingFloorDetector::compute(
 		// Each list holds a cell at most once: reserved to that bound, so no
 		// later frame allocates (grown on demand, a pipeline that had seen only
 		// a few frames -- one per camera -- still grew them now and then).
-		for (std::vector<uint32_t>* v : {&m_touched, &m_cells, &m_blocking, &m_queue, &m_region}) v->reserve(N);
+		for (std::vector<uint32_t>* v : {&m_touched, &m_cells, &m_blocking, &m_queue, &m_region, &m_component})
+			v->reserve(N);
+		// A cell's ring around a sensor within the grid: at most its diagonal.
+		const size_t rings = size_t(std::ceil(std::hypot(double(g.nx), double(g.ny)))) + 2;
+		m_ringRays.assign(rings, 0u);
+		m_ringEmpty.assign(rings, 0u);
 	}
 	if (!frame.has_image || classes.size() != N || !(maxRange > 0)) return;
 	const RangeImageView& img = frame.image;
@@ -684,9 +689,219 @@ void MissingFloorDetector::compute(
 			if (grid.cell(b).count > 0 && classes[b] != VoxelClass::Drop) return false;
 		}
 	};
+	// Rule MF10's second closure: a step's shadow whose lower surface lies
+	// beyond the range (the rays over the edge return nothing at all). The
+	// ground point of (x, y), its depth (range for range images), and
+	// whether a pixel of the image looks at it.
+	const auto groundPoint = [&](double x, double y) {
+		return Eigen::Vector3d(x, y, -(n.x() * x + n.y() * y + d) / n.z());
+	};
+	const auto depthOf = [&](const Eigen::Vector3d& p) { return img.is_depth ? (p - s).dot(xAxis) : (p - s).norm(); };
+	// For a depth image the ground point's depth is affine in (x, y): the
+	// plane's z is, and so is the dot product with the camera's axis.
+	const double zx = -n.x() / n.z(), zy = -n.y() / n.z(), z0 = -d / n.z();
+	const double depthX = xAxis.x() + zx * xAxis.z(), depthY = xAxis.y() + zy * xAxis.z();
+	const double depth0 = (z0 - s.z()) * xAxis.z() - s.x() * xAxis.x() - s.y() * xAxis.y();
+	const auto cellDepth = [&](uint32_t c) {
+		const double x = g.cx(int(c % uint32_t(g.nx))), y = g.cy(int(c / uint32_t(g.nx)));
+		return img.is_depth ? depthX * x + depthY * y + depth0 : depthOf(groundPoint(x, y));
+	};
+	const auto inImage = [&](const Eigen::Vector3d& p) {
+		const Eigen::Vector3d q = R.transpose() * (p - s);
+		if (!(q.x() > 0)) return false;
+		const double u = K.cx - K.fx * q.y() / q.x(), v = K.cy - K.fy * q.z() / q.x();
+		return u >= -0.5 && u <= K.width - 0.5 && v >= -0.5 && v <= K.height - 0.5;
+	};
+	const auto horizontalDist = [&](uint32_t c) {
+		const double dx = g.cx(int(c % uint32_t(g.nx))) - s.x(), dy = g.cy(int(c / uint32_t(g.nx))) - s.y();
+		return std::sqrt(dx * dx + dy * dy);
+	};
+	// Only a region that comes near the end of the range (or of the grid)
+	// can run to it: the walks below are for those.
+	const int nearEnd = 5;
+	const auto nearRangeEnd = [&](const std::vector<uint32_t>& region) {
+		for (uint32_t c : region)
+		{
+			const int cx = int(c % uint32_t(g.nx)), cy = int(c / uint32_t(g.nx));
+			if (cx < nearEnd || cy < nearEnd || cx >= g.nx - nearEnd || cy >= g.ny - nearEnd ||
+				cellDepth(c) > maxRange - nearEnd * g.resolution)
+				return true;
+		}
+		return false;
+	};
+	// Its evidence: the region's cells nearer than where depth noise may
+	// carry floor returns beyond the range, judged against the dropout rate
+	// of every ray at the same distance from the sensor, the region's own
+	// included (a floor cell holds a sample per returning ray): near the end
+	// of a time-of-flight camera's range the floor drops out with its
+	// incidence, which grows along a range bin and towards the image's sides
+	// (the simulated Kinect One drops 58 % of the floor's pixels 4.0 m ahead,
+	// 71 % 4.9 m away to the side), and where the range's end cuts off the
+	// floor across the view, every ray there is empty (no evidence). And
+	// the region was picked as a connected cluster of empty cells
+	// among many: the chance that dropping-out floor leaves some cluster of
+	// k cells empty around a given cell is at most (e (8 - 1))^(k - 1) times
+	// that of one given cluster (the lattice animals of a graph of degree 8),
+	// so each cell's chance counts e * 7 = 19 times. A hole at the end of a
+	// D455's range (q = 0.40, 4-5 rays a cell: 0.016 a cell) stays evidence;
+	// a cluster of the Kinect One's dropouts there (q = 0.6: 0.13) does not.
+	bool ringsFilled = false;
+	const auto rangeEndEvidence = [&](const std::vector<uint32_t>& region) {
+		if (!ringsFilled)
+		{
+			// Rays and empty rays per ring (one cell wide) around the sensor:
+			// floor cells' samples and empty rays, and the empty rays of cells
+			// where nothing was seen.
+			std::fill(m_ringRays.begin(), m_ringRays.end(), 0u);
+			std::fill(m_ringEmpty.begin(), m_ringEmpty.end(), 0u);
+			const auto add = [&](uint32_t c, uint32_t rays) {
+				const size_t ring = size_t(horizontalDist(c) / g.resolution);
+				if (ring >= m_ringRays.size()) return;
+				m_ringRays[ring] += rays;
+				m_ringEmpty[ring] += m_empty[c];
+			};
+			for (uint32_t c : grid.observedCells())
+				if (classes[c] == VoxelClass::Ground) add(c, grid.cell(c).count + m_empty[c]);
+			for (uint32_t c : m_touched)
+				if (grid.cell(c).count == 0) add(c, m_empty[c]);
+			ringsFilled = true;
+		}
+		double lo = std::numeric_limits<double>::infinity(), hi = 0;
+		for (uint32_t c : region)
+			if (cellDepth(c) <= maxRange - m_rangeEndMargin)
+			{
+				lo = std::min(lo, horizontalDist(c));
+				hi = std::max(hi, horizontalDist(c));
+			}
+		if (!(hi > 0)) return 0.0;
+		uint64_t rays = 0, empty = 0;
+		const size_t r0 = size_t(std::max(0.0, lo / g.resolution - 1)), r1 = size_t(hi / g.resolution + 1);
+		for (size_t r = r0; r <= r1 && r < m_ringRays.size(); r++)
+		{
+			rays += m_ringRays[r];
+			empty += m_ringEmpty[r];
+		}
+		if (rays == 0) return 0.0;
+		const double q = double(empty) / double(rays);
+		const double logAnimals = std::log(std::exp(1.0) * 7.0);
+		double logChance = 0;
+		for (uint32_t c : region)
+			if (cellDepth(c) <= maxRange - m_rangeEndMargin)
+				logChance += logAnimals + std::log(std::max(missing::emptyCellChance(q, m_p11, m_empty[c]), 1e-300));
+		return logChance;
+	};
+	// Whether at least min_rays rays of the region are a step's shadow that
+	// runs to the end of the range. Back along the ray, through cells where
+	// nothing was seen, seen floor (the edge; not under a ramp patch), and
+	// from there to the sensor the ray passes above everything seen: it met
+	// nothing before the gap (a surface it grazes there, as a ramp's way
+	// down or a table's top, drops out on its own). On along the ray,
+	// through cells where nothing was seen and within the image, the end of
+	// the range (or of the grid, the map's own reach).
+	const auto runsToRangeEnd = [&](const std::vector<uint32_t>& region) {
+		int rays = 0;
+		for (uint32_t c : region)
+		{
+			const double x0 = g.cx(int(c % uint32_t(g.nx))), y0 = g.cy(int(c / uint32_t(g.nx)));
+			const double ux = x0 - s.x(), uy = y0 - s.y();
+			const double len = std::sqrt(ux * ux + uy * uy);
+			if (!(len > 0)) continue;
+			// On along the ray first (a few cells to the end of the range, or a
+			// seen cell), then back to the sensor.
+			bool toEnd = false;
+			for (int step = 1;; step++)
+			{
+				const double k = step * g.resolution / len;
+				const double x = x0 + k * ux, y = y0 + k * uy;
+				const int ax = g.ix(x), ay = g.iy(y);
+				const bool inGrid = g.inside(ax, ay);
+				if (inGrid && grid.cell(g.index(ax, ay)).count > 0) break;  // seen: not the range's end
+				const Eigen::Vector3d p = groundPoint(x, y);
+				if (!inImage(p)) break;  // the edge of the view
+				if (!inGrid || depthOf(p) > maxRange - g.resolution)
+				{
+					toEnd = true;
+					break;
+				}
+			}
+			if (!toEnd) continue;
+			bool edge = false, clear = true;
+			for (int step = 1; clear && step * g.resolution < len; step++)
+			{
+				const double k = -step * g.resolution / len;
+				const double x = x0 + k * ux, y = y0 + k * uy;
+				const int bx = g.ix(x), by = g.iy(y);
+				if (!g.inside(bx, by)) break;
+				const size_t b = g.index(bx, by);
+				const ElevationCell& cb = grid.cell(b);
+				if (cb.count == 0) continue;
+				if (!edge)
+				{
+					edge = classes[b] == VoxelClass::Ground && !patches.applies(uint32_t(b));
+					clear = edge;
+				}
+				// The ray's height over the ground here, against the cell's top.
+				const double rayHeight = sensorHeight * step * g.resolution / len;
+				if (n.x() * x + n.y() * y + n.z() * double(cb.z_max) + d >= rayHeight) clear = false;
+			}
+			if (edge && clear && ++rays >= m_params.min_rays) return true;
+		}
+		return false;
+	};
+	// A step's shadow at the end of the range holds cells that count alone
+	// and cells that do not (fewer rays): it is judged as one, the connected
+	// component of the candidates of both kinds nearer than the range's
+	// noisy end (where the range cuts the floor off along its whole arc,
+	// which would join unrelated gaps; those cells stay unknown), from `seed`.
+	// Each component is judged once a frame (its cells marked kJudged).
+	const auto gatherComponent = [&](uint32_t seed) {
+		m_component.clear();
+		m_component.push_back(seed);
+		m_mark[seed] |= kJudged;
+		for (size_t qi = 0; qi < m_component.size(); qi++)
+		{
+			const int cx = int(m_component[qi] % uint32_t(g.nx)), cy = int(m_component[qi] / uint32_t(g.nx));
+			for (int dy = -1; dy <= 1; dy++)
+				for (int dx = -1; dx <= 1; dx++)
+				{
+					const int ax = cx + dx, ay = cy + dy;
+					if ((!dx && !dy) || !g.inside(ax, ay)) continue;
+					const uint32_t a = uint32_t(g.index(ax, ay));
+					const uint8_t m = m_mark[a];
+					if ((m & (kCandidate | kWeak)) && !(m & (kMissing | kJudged)) &&
+						cellDepth(a) <= maxRange - m_rangeEndMargin)
+					{
+						m_mark[a] |= kJudged;
+						m_component.push_back(a);
+					}
+				}
+		}
+	};
+	const double nextP = std::clamp(m_p11, 0.0, 1.0 - 1e-9);
+	// Marks a kept region's cells missing (but where a ramp or landing patch
+	// applies: judged against the wrong surface, see compute()'s comment).
+	const auto markMissing = [&](const std::vector<uint32_t>& region) {
+		for (uint32_t c : region)
+		{
+			if (patches.applies(c))
+			{
+				stats.under_patches++;
+				continue;
+			}
+			m_mark[c] = kMissing;
+			m_cells.push_back(c);
+			if (dist2(int(c % uint32_t(g.nx)), int(c / uint32_t(g.nx))) <= block2)
+			{
+				m_mark[c] |= kBlocking;
+				m_blocking.push_back(c);
+			}
+		}
+	};
 	for (uint32_t seed : m_touched)
 	{
-		const uint8_t kind = m_mark[seed];
+		// (kJudged: a component judged as a step's shadow that runs to the
+		// end of the range; no part of a region's own judgement.)
+		const uint8_t kind = m_mark[seed] & uint8_t(~kJudged);
 		if (kind != kCandidate && kind != kWeak) continue;
 		m_region.clear();
 		m_queue.clear();
@@ -735,7 +950,7 @@ void MissingFloorDetector::compute(
 					const int ax = cx + dx, ay = cy + dy;
 					if (!g.inside(ax, ay)) continue;
 					const uint32_t a = uint32_t(g.index(ax, ay));
-					if (m_mark[a] == kind)
+					if ((m_mark[a] & uint8_t(~kJudged)) == kind)
 					{
 						m_mark[a] |= kVisited;
 						m_queue.push_back(a);
@@ -751,31 +966,29 @@ void MissingFloorDetector::compute(
 		if (!bordered)
 		{
 			stats.unbordered++;
+			// A step's shadow that runs to the end of the range: the
+			// components of the region's cells, each judged once.
+			if (pool && nearRangeEnd(m_region))
+				for (uint32_t c : m_region)
+				{
+					if ((m_mark[c] & (kJudged | kMissing)) || cellDepth(c) > maxRange - m_rangeEndMargin) continue;
+					gatherComponent(c);
+					if (rangeEndEvidence(m_component) * (1.0 - nextP) <= logAlphaPooled && runsToRangeEnd(m_component))
+					{
+						stats.range_end_regions++;
+						stats.regions++;
+						markMissing(m_component);
+					}
+				}
 			continue;
 		}
 		if (kind == kWeak)
 		{
-			const double next = std::clamp(m_p11, 0.0, 1.0 - 1e-9);
-			if (logChance * (1.0 - next) > logAlphaPooled) continue;
+			if (logChance * (1.0 - nextP) > logAlphaPooled) continue;
 			stats.pooled_regions++;
 		}
 		stats.regions++;
-		for (uint32_t c : m_region)
-		{
-			if (patches.applies(c))
-			{
-				// Judged against the wrong surface (see compute()'s comment).
-				stats.under_patches++;
-				continue;
-			}
-			m_mark[c] = kMissing;
-			m_cells.push_back(c);
-			if (dist2(int(c % uint32_t(g.nx)), int(c / uint32_t(g.nx))) <= block2)
-			{
-				m_mark[c] |= kBlocking;
-				m_blocking.push_back(c);
-			}
-		}
+		markMissing(m_region);
 	}
 	stats.cells = m_cells.size();
 	stats.blocking = m_blocking.size();

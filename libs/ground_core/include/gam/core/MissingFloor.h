@@ -20,7 +20,8 @@
 // both nearer to the sensor and farther away: a gap inside the floor, not the place where the
 // returns stop (a range cutoff) or start (the robot's own body). The shadow
 // of a step down is a gap too: beyond it, a lower surface where the edge's
-// shadow ends; its cells are judged together (step_shadows).
+// shadow ends, or, when that lies beyond the range, nothing up to the end of
+// the range; its cells are judged together (step_shadows).
 // Pure code: no MRPT, no I/O; no heap allocation per frame once sized.
 #pragma once
 
@@ -65,7 +66,13 @@ struct MissingFloorParams
 	 * below the ground where the edge's shadow on it ends
 	 * (missing::isStepShadow). Near the end of a camera's range, where the
 	 * floor drops out often and the rows are sparse, no cell of a step's
-	 * shadow holds enough rays alone; a region of them does. */
+	 * shadow holds enough rays alone; a region of them does. And a shadow
+	 * whose lower surface lies beyond the range (or the grid) is closed by
+	 * the range's end: its rays start at seen floor with nothing seen above
+	 * them nearer and run through unseen cells to the end of the range
+	 * inside the image, and its cells are rarer than any cluster of floor
+	 * dropouts that large, judged against every ray at the same distance
+	 * from the sensor (see compute()). */
 	bool step_shadows = true;
 
 	template <class Self, class Visit>
@@ -93,7 +100,8 @@ struct MissingFloorParams
 		visit(
 			ParamInfo{
 				"missing_floor_step_shadows", 0, 1,
-				"judge the shadow of a step down as one region (its cells have too few rays alone)"},
+				"judge the shadow of a step down as one region (its cells have too few rays alone), also when it runs "
+				"to the end of the range"},
 			p.step_shadows);
 	}
 	/** Throws std::invalid_argument naming the parameter out of range. */
@@ -109,10 +117,11 @@ struct MissingFloorStats
 	size_t regions = 0;     ///< their connected regions
 	size_t unbordered =
 		0;  ///< candidate regions dropped: no seen floor before, or neither floor nor a step's lower surface beyond
-	size_t pooled_regions = 0;  ///< regions kept on their weak candidates' evidence together
-	size_t blocking = 0;        ///< missing cells within block_range
-	size_t under_patches = 0;   ///< cells of bordered regions left out: a ramp or landing patch applies there
-	bool applied = false;       ///< the stage ran on this frame
+	size_t pooled_regions = 0;     ///< regions kept on their weak candidates' evidence together
+	size_t range_end_regions = 0;  ///< regions kept as a step's shadow that runs to the end of the range
+	size_t blocking = 0;           ///< missing cells within block_range
+	size_t under_patches = 0;      ///< cells of bordered regions left out: a ramp or landing patch applies there
+	bool applied = false;          ///< the stage ran on this frame
 };
 
 namespace missing
@@ -164,6 +173,10 @@ class MissingFloorDetector
 	 * there, and one more than half a pixel of disparity nearer than the
 	 * floor point hides it). */
 	void setSecondImagerBaseline(double baseline) { m_baseline = baseline > 0 ? baseline : 0; }
+	/** How far before maxRange the camera's depth noise may carry a floor
+	 * return beyond it [m] (depth): empty rays there are no evidence that a
+	 * step's shadow runs to the end of the range. */
+	void setRangeEndMargin(double margin) { m_rangeEndMargin = margin > 0 ? margin : 0; }
 
 	/** One depth frame (frame.has_image) after the 2.5D map, the ground and
 	 * the ISM classes of that frame are known (`classes`: None exactly for
@@ -203,15 +216,17 @@ class MissingFloorDetector
 	double neighbourDropoutRate() const { return m_p11; }
 
    private:
-	static constexpr uint8_t kCandidate = 1, kMissing = 2, kVisited = 4, kBlocking = 8, kWeak = 16;
+	static constexpr uint8_t kCandidate = 1, kMissing = 2, kVisited = 4, kBlocking = 8, kWeak = 16, kJudged = 32;
 	MissingFloorParams m_params;
 	std::vector<uint16_t> m_empty;   ///< per frame cell
 	std::vector<uint8_t> m_mark;     ///< per frame cell
 	std::vector<float> m_logChance;  ///< per weak candidate cell: log of its chance
-	std::vector<uint32_t> m_touched, m_cells, m_blocking, m_queue, m_region;
+	std::vector<uint32_t> m_touched, m_cells, m_blocking, m_queue, m_region, m_component;
+	std::vector<uint32_t> m_ringRays, m_ringEmpty;  ///< per ring of one cell around the sensor
 	std::vector<uint32_t> m_binRays, m_binEmpty;
 	double m_p11 = -1;
 	double m_baseline = 0;
+	double m_rangeEndMargin = 0;
 	// One image row: 1 for each pixel that needs judging, and the depth at
 	// which each ray meets the ground and the (fractional) grid cell it meets
 	// there (see compute()).
