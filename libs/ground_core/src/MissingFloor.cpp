@@ -620,6 +620,11 @@ void MissingFloorDetector::compute(
 	// together with the weak cells connected to them (step 3).
 	const bool pool = m_params.step_shadows;
 	const Eigen::Vector3d xAxis = R.col(0);
+	// The ground point of (x, y) and its depth (range for range images).
+	const auto groundPoint = [&](double x, double y) {
+		return Eigen::Vector3d(x, y, -(n.x() * x + n.y() * y + d) / n.z());
+	};
+	const auto depthOf = [&](const Eigen::Vector3d& p) { return img.is_depth ? (p - s).dot(xAxis) : (p - s).norm(); };
 	for (uint32_t cell : m_touched)
 	{
 		const int n_ = m_empty[cell];
@@ -627,8 +632,7 @@ void MissingFloorDetector::compute(
 		const int cx = int(cell % uint32_t(g.nx)), cy = int(cell / uint32_t(g.nx));
 		const double x = g.cx(cx), y = g.cy(cy);
 		if (std::abs(n.z()) < 1e-9) continue;
-		const Eigen::Vector3d pc(x, y, -(n.x() * x + n.y() * y + d) / n.z());
-		const double depth = img.is_depth ? (pc - s).dot(xAxis) : (pc - s).norm();
+		const double depth = depthOf(groundPoint(x, y));
 		const double chance = missing::emptyCellChance(dropoutRate(depth), m_p11, n_);
 		if (chance > m_params.alpha)
 		{
@@ -689,14 +693,9 @@ void MissingFloorDetector::compute(
 			if (grid.cell(b).count > 0 && classes[b] != VoxelClass::Drop) return false;
 		}
 	};
-	// Rule MF10's second closure: a step's shadow whose lower surface lies
-	// beyond the range (the rays over the edge return nothing at all). The
-	// ground point of (x, y), its depth (range for range images), and
-	// whether a pixel of the image looks at it.
-	const auto groundPoint = [&](double x, double y) {
-		return Eigen::Vector3d(x, y, -(n.x() * x + n.y() * y + d) / n.z());
-	};
-	const auto depthOf = [&](const Eigen::Vector3d& p) { return img.is_depth ? (p - s).dot(xAxis) : (p - s).norm(); };
+	// Rule MF11: a step's shadow whose lower surface lies beyond the range
+	// (the rays over the edge return nothing at all). A cell's ground
+	// depth, and whether a pixel of the image looks at a point.
 	// For a depth image the ground point's depth is affine in (x, y): the
 	// plane's z is, and so is the dot product with the camera's axis.
 	const double zx = -n.x() / n.z(), zy = -n.y() / n.z(), z0 = -d / n.z();

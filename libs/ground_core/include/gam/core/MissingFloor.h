@@ -117,11 +117,12 @@ struct MissingFloorStats
 	size_t regions = 0;     ///< their connected regions
 	size_t unbordered =
 		0;  ///< candidate regions dropped: no seen floor before, or neither floor nor a step's lower surface beyond
-	size_t pooled_regions = 0;     ///< regions kept on their weak candidates' evidence together
-	size_t range_end_regions = 0;  ///< regions kept as a step's shadow that runs to the end of the range
-	size_t blocking = 0;           ///< missing cells within block_range
-	size_t under_patches = 0;      ///< cells of bordered regions left out: a ramp or landing patch applies there
-	bool applied = false;          ///< the stage ran on this frame
+	size_t pooled_regions = 0;  ///< regions kept on their weak candidates' evidence together
+	size_t range_end_regions =
+		0;  ///< components of unbordered regions kept as a step's shadow that runs to the end of the range (rule MF11)
+	size_t blocking = 0;       ///< missing cells within block_range
+	size_t under_patches = 0;  ///< cells of bordered regions left out: a ramp or landing patch applies there
+	bool applied = false;      ///< the stage ran on this frame
 };
 
 namespace missing
