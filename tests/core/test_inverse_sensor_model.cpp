@@ -469,6 +469,85 @@ TEST(InverseSensorModel, WithIndependentSamplesTheDeepThresholdIsTheTraversableS
 	EXPECT_EQ(st.ground, 1u);
 }
 
+TEST(IsmFormulas, ChiSquareQuantileByTheCubeRoot)
+{
+	// Wilson-Hilferty at z = 3 (upper tail Phi(-3) = 0.0013499), 29 degrees
+	// of freedom: v = 2 / (9 * 29) = 0.0076628, q = 1 - v + 3 sqrt(v) = 1 -
+	// 0.0076628 + 3 * 0.0875376 = 1.2549500, 29 q^3 = 29 * 1.9764203 = 57.3162
+	// (the exact quantile, by the incomplete gamma function, is 57.2253).
+	EXPECT_FALSE(ism::chiSquareAbove(57.31, 29, 3.0));
+	EXPECT_TRUE(ism::chiSquareAbove(57.32, 29, 3.0));
+	// 3 degrees of freedom: v = 0.0740741, q = 1 - v + 3 * 0.2721655 =
+	// 1.7424224, 3 q^3 = 3 * 5.2899 = 15.870 (exact 15.631).
+	EXPECT_FALSE(ism::chiSquareAbove(15.86, 3, 3.0));
+	EXPECT_TRUE(ism::chiSquareAbove(15.88, 3, 3.0));
+	EXPECT_FALSE(ism::chiSquareAbove(1e9, 0, 3.0));  // one sample has no spread
+}
+
+TEST(InverseSensorModel, RaisedSamplesSpreadOverMoreThanOneSurfaceMakeAnObstacle)
+{
+	// Issue #27's cable far away: a cell holds the floor and a low object's
+	// face, seen as rows from 0 up, while its mean and top stay inside their
+	// bands. The cell of handDeepThreshold, a Kinect One (time of flight:
+	// independent samples; its vertical sigma stays the IsmParams model's):
+	// sigma = 0.0035591, s = 0.0106145, T = traversable_step = 0.02, p0 =
+	// Phi(-0.02 / 0.0106145) = 0.029768 (as for the deep samples).
+	// 24 samples at 0 and 6 at 0.021: top 0.021 < one-sample band 0.0406772,
+	// |mean| = 6 * 0.021 / 30 = 0.0042 < d_pth: floor by both. Count: k = 6 of
+	// 30 above T, P(X >= 6) = 0.000223 < Phi(-3) = 0.0013499. Spread: var =
+	// 6 * 0.021^2 / 30 - 0.0042^2 = 0.0000882 - 0.00001764 = 0.00007056, N var
+	// / sigma^2 = 30 * 0.00007056 / 0.0035591^2 = 167.1 > 57.316 (29 degrees
+	// of freedom, ChiSquareQuantileByTheCubeRoot): an obstacle.
+	const auto timeOfFlight = [](InverseSensorModel& m) {
+		m.setCameraNoise(cameraNoisePreset(CameraModel::KinectOne), 600);
+	};
+	InverseSensorModel ism(deepParams());
+	timeOfFlight(ism);
+	IsmStats st;
+	BinnedPoints b;
+	auto classOf = [&](InverseSensorModel& m, const ElevationGrid& f) {
+		m.compute(f, handDetection(kFloor), {0, 0, 1}, 5.0, st, &b);
+		return m.classes()[f.geometry().index(f.geometry().ix(kDeepX), f.geometry().iy(kDeepY))];
+	};
+	const ElevationGrid face = deepCellFrame(24, std::vector<float>(6, 0.021f), b);
+	EXPECT_EQ(classOf(ism, face), VoxelClass::Obstacle);
+	EXPECT_EQ(st.raised_obstacles, 1u);
+	EXPECT_EQ(st.obstacle, 1u);
+	EXPECT_EQ(st.ground, 0u);
+	EXPECT_GT(ism.evidence()[face.geometry().index(face.geometry().ix(kDeepX), face.geometry().iy(kDeepY))], 0.5f);
+	// Switched off, or a camera whose samples share part of their error (the
+	// count is no binomial there), or one of unknown noise: the floor it was.
+	IsmParams off = deepParams();
+	off.raised_sample_test = false;
+	InverseSensorModel noRaised(off);
+	timeOfFlight(noRaised);
+	EXPECT_EQ(classOf(noRaised, face), VoxelClass::Ground);
+	EXPECT_EQ(st.raised_obstacles, 0u);
+	InverseSensorModel shared(deepParams());
+	shareNoise(shared);
+	EXPECT_EQ(classOf(shared, face), VoxelClass::Ground);
+	InverseSensorModel unknown(deepParams());
+	unknown.setCameraNoise(cameraNoisePreset(CameraModel::Custom), 600);
+	EXPECT_EQ(classOf(unknown, face), VoxelClass::Ground);
+	// 5 such samples: P(X >= 5) = 0.00179 > Phi(-3), though they spread as
+	// much (N var / sigma^2 = 145.1): floor.
+	const ElevationGrid five = deepCellFrame(25, std::vector<float>(5, 0.021f), b);
+	EXPECT_EQ(classOf(ism, five), VoxelClass::Ground);
+	// 1 mm below T the six do not count.
+	const ElevationGrid low = deepCellFrame(24, std::vector<float>(6, 0.019f), b);
+	EXPECT_EQ(classOf(ism, low), VoxelClass::Ground);
+	// One surface 2.1 cm up, as a ramp's cell where no patch applies: 15
+	// samples at 0.018 and 15 at 0.024 (mean 0.021 < d_pth, floor by the
+	// mean test). All 15 at 0.024 lie above T (P(X >= 15) is ~1e-14), but
+	// they spread no more than one sample's noise: var = 0.003^2, N var /
+	// sigma^2 = 30 * 0.000009 / 0.0035591^2 = 21.3 < 57.316: floor.
+	std::vector<float> ramp(15, 0.018f);
+	ramp.insert(ramp.end(), 15, 0.024f);
+	const ElevationGrid plane = deepCellFrame(0, ramp, b);
+	EXPECT_EQ(classOf(ism, plane), VoxelClass::Ground);
+	EXPECT_EQ(st.raised_obstacles, 0u);
+}
+
 TEST(InverseSensorModel, DeepSampleCountIsJudgedAgainstTheCellsSampleCount)
 {
 	// The same 3 deep samples among n = 300: floor noise gives P(X >= 3) with

@@ -11,7 +11,7 @@ trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
 read -r -a labels <<< "$(bash "$tool" --labels)"
-[[ ${#labels[@]} -eq 22 ]] || fail "22 labels expected, got ${#labels[@]}: ${labels[*]}"
+[[ ${#labels[@]} -eq 23 ]] || fail "23 labels expected, got ${#labels[@]}: ${labels[*]}"
 [[ ${labels[0]} == ground_aware && ${labels[1]} == paper ]] || fail "the default and the paper first: ${labels[*]}"
 
 bash "$tool" "$src/config/ground-aware-mapper.ini" > "$tmp/ablation.ini"
@@ -41,6 +41,7 @@ opts_of ground_aware | grep -qx "range_smear=true" || fail "ground_aware keeps r
 opts_of no_ground_offset | grep -qx "max_ground_offset=0" || fail "no_ground_offset"
 opts_of no_patch_memory | grep -qx "patch_memory=0" || fail "no_patch_memory"
 opts_of no_step_shadows | grep -qx "missing_floor_step_shadows=false" || fail "no_step_shadows"
+opts_of no_raised_sample_test | grep -qx "raised_sample_test=false" || fail "no_raised_sample_test"
 [[ $(opts_of ground_aware | grep -c "ism_model=paper") -eq 0 ]] || fail "ground_aware must not be the paper's ISM"
 # Each key appears once per section (a variant replaces the base's value).
 for l in "${labels[@]}"; do

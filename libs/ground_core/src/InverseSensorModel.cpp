@@ -461,6 +461,13 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 			hold(Held{d.cell, k, true, m_params.drop_rays, true}, smear, frame, stats);
 			continue;
 		}
+		if (d.kind == TailKind::Raised)
+		{
+			if (k < minPoints() || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
+			m_class[d.cell] = VoxelClass::Obstacle;
+			hold(Held{d.cell, k, false, false, true}, smear, frame, stats);
+			continue;
+		}
 		// An obstacle or a drop judged by its extreme sample: it takes as many
 		// samples beyond the band as any other (a lone spike among floor
 		// samples is no obstacle, and casts no ray).
@@ -487,7 +494,7 @@ void InverseSensorModel::give(const Held& h, const ElevationGrid& frame, IsmStat
 	if (h.deep)
 	{
 		stats.ground--;
-		stats.deep_drops++;
+		(h.drop ? stats.deep_drops : stats.raised_obstacles)++;
 	}
 	(h.drop ? stats.drop : stats.obstacle)++;
 	put(h.cell, obstacleEvidence(frame.cell(h.cell), frame.geometry().resolution));
@@ -559,6 +566,12 @@ void InverseSensorModel::compute(
 	const bool deepTest = m_params.deep_sample_test && haveSamples && m_params.noise_sigmas > 0;
 	// Whether the camera's samples share part of their error (see the deep-sample test).
 	const bool sharedNoise = m_camera.correlated(1.0, m_fx) > 0;
+	// Counting above the plane assumes independent samples: a camera whose
+	// noise is time of flight's alone (raised_sample_test). A camera of unknown
+	// noise (`custom` with no coefficients: a Kinect v1's 640 x 480 at 62.7
+	// deg, structured light) is not taken to have them.
+	const bool timeOfFlight = !sharedNoise && !(m_camera.baseline > 0) && m_camera.independent(1.0, m_fx) > 0;
+	const bool raisedTest = deepTest && m_params.raised_sample_test && timeOfFlight;
 	const bool smear = smearTest();
 	m_tailCandidates.clear();
 	m_held.clear();
@@ -629,6 +642,17 @@ void InverseSensorModel::compute(
 					double p0 = ism::normalTail(T / s);
 					if (sharedNoise && sigma > 0) p0 = std::max(p0, ism::normalTail((T + dMean) / sigma));
 					m_tailCandidates.push_back({idx, TailKind::Deep, float(p0)});
+				}
+				else if (
+					raisedTest && s > 0 && sigma > 0 && c.count >= minPoints() &&
+					pl.signedDistance(x, y, c.z_max) > T && pl.c > 0 &&
+					ism::chiSquareAbove(double(c.count) * double(c.variance()) / (sigma * sigma), c.count - 1, k))
+				{
+					// The same count above the plane, where the cell's samples
+					// spread over more than one surface (a low object's face
+					// and top, not a ramp's plane).
+					m_tailHi[idx] = float(pl.heightAt(x, y) + T / pl.c);
+					m_tailCandidates.push_back({idx, TailKind::Raised, float(ism::normalTail(T / s))});
 				}
 			}
 		}

@@ -84,6 +84,23 @@ struct IsmParams
 	 * drop_ray_min_points (a depth spike is not a hole). Off: the cell's
 	 * z_min and mean only. */
 	bool deep_sample_test = true;
+	/** The deep-sample test's count above the plane, for a camera whose
+	 * samples are independent (time of flight; issue #27's cable). Far away a
+	 * low object's cell holds its front face, seen as rows 1 cm apart from 0
+	 * up to its height, and a few samples of its top: its mean stays inside
+	 * the mean test's band and its top sample inside the one-sample band, yet
+	 * several of its samples lie higher than any floor sample would. A cell
+	 * is an obstacle when (1) k of its N samples lie more than T =
+	 * traversable_step above the plane with P(Binomial(N, Phi(-T / s)) >= k) <
+	 * Phi(-noise_sigmas) and k >= min_obstacle_points (the deep-sample test's
+	 * count, s as there), and (2) its samples spread more than one surface's
+	 * do: N var / sigma^2 (sigma: one sample's vertical noise, the band's) is
+	 * above the chi-square quantile of N - 1 degrees of freedom at
+	 * Phi(-noise_sigmas) (Wilson-Hilferty). (2) keeps a ramp's cells, which
+	 * lie on one surface above the floor where no patch applies, to the mean
+	 * test: the count alone took a held-out ramp below 95 % free (2026-11-27).
+	 * Off: the deep-sample test counts below the plane only. */
+	bool raised_sample_test = true;
 	/** A surface's samples moved along their rays by the range noise
 	 * (issue #27). A depth sample's error lies along its ray: a wall at range
 	 * r whose samples scatter by sigma(r) puts some of them into the floor
@@ -182,6 +199,12 @@ struct IsmParams
 			p.deep_sample_test);
 		visit(
 			ParamInfo{
+				"raised_sample_test", 0, 1,
+				"time of flight: a cell with more samples above traversable_step than floor noise explains, spread "
+				"over more than one surface, is an obstacle"},
+			p.raised_sample_test);
+		visit(
+			ParamInfo{
 				"range_smear", 0, 1,
 				"an obstacle (drop) cell whose samples beyond the band are what the range noise of a cell of the "
 				"same class behind (before) it along its ray, or of one as high beyond the judged range, moves there "
@@ -235,6 +258,17 @@ double groundProbability(double d, const IsmParams& p);
 double binomialTail(uint32_t n, double p, uint32_t k);
 /** P(Z < -x) for a standard normal Z. */
 inline double normalTail(double x) { return 0.5 * std::erfc(x / std::sqrt(2.0)); }
+/** Whether x lies above the chi-square quantile of `dof` degrees of freedom
+ * whose upper tail is P(Z > z) for a standard normal Z, by the
+ * Wilson-Hilferty cube root: chi2 / dof ~ N(1 - 2 / (9 dof), 2 / (9 dof))^3
+ * (at z = 3 at most 2 % above the quantile from 2 degrees of freedom on, 1 %
+ * from 5). */
+inline bool chiSquareAbove(double x, uint32_t dof, double z)
+{
+	if (dof == 0) return false;
+	const double v = 2.0 / (9.0 * double(dof)), q = 1.0 - v + z * std::sqrt(v);
+	return q > 0 && x > double(dof) * q * q * q;
+}
 /** The k-th smallest of v[0..n) (0-based, k < n; v is reordered), the value
  * std::nth_element puts at v[k]. A quickselect whose partition has no branch
  * per element: introselect branches on each comparison, which no predictor
@@ -319,6 +353,7 @@ struct IsmStats
 	size_t drop_ray_cells = 0;
 	size_t drop_rays_unsupported = 0;  ///< drop rays not cast: an obstacle stood between the sensor and the crossing
 	size_t deep_drops = 0;             ///< drops found by the deep-sample count alone
+	size_t raised_obstacles = 0;       ///< obstacles found by the raised-sample count alone
 	size_t smeared = 0;    ///< obstacle / drop cells whose samples beyond the band are another cell's (range_smear)
 	bool applied = false;  ///< false when there was no ground plane
 };
@@ -472,7 +507,8 @@ class InverseSensorModel
 		const ElevationGrid& frame, uint32_t cell, uint32_t beyond, bool drop, const Eigen::Vector3d& sensor) const;
 	/** An obstacle or drop cell about to give evidence: its samples beyond
 	 * the band, what it is, whether it casts a drop ray, whether the
-	 * deep-sample test made it a drop; range_smear's verdict. */
+	 * deep- (raised-) sample test made it a drop (an obstacle); range_smear's
+	 * verdict. */
 	struct Held
 	{
 		uint32_t cell;
@@ -512,9 +548,10 @@ class InverseSensorModel
 	// the count, and p0 of the deep-sample test.
 	enum class TailKind : uint8_t
 	{
-		Deep,   ///< deep_sample_test on a ground cell
-		Above,  ///< obstacle by its top sample
-		Below   ///< drop by its bottom sample
+		Deep,    ///< deep_sample_test on a ground cell
+		Raised,  ///< raised_sample_test on a ground cell
+		Above,   ///< obstacle by its top sample
+		Below    ///< drop by its bottom sample
 	};
 	struct TailCandidate
 	{
