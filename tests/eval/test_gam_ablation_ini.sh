@@ -15,7 +15,7 @@ read -r -a labels <<< "$(bash "$tool" --labels)"
 [[ ${labels[0]} == ground_aware && ${labels[1]} == paper ]] || fail "the default and the paper first: ${labels[*]}"
 
 bash "$tool" "$src/config/ground-aware-mapper.ini" > "$tmp/ablation.ini"
-grep -qx "groundAwareGrid_count=22" "$tmp/ablation.ini" || fail "groundAwareGrid_count=22 missing"
+grep -qx "groundAwareGrid_count=23" "$tmp/ablation.ini" || fail "groundAwareGrid_count=23 missing"
 # The _groundOpts section of the grid labelled $1, as KEY=VALUE lines without comments.
 opts_of() {
 	local nn
