@@ -972,7 +972,10 @@ void MissingFloorDetector::compute(
 				{
 					if ((m_mark[c] & (kJudged | kMissing)) || cellDepth(c) > maxRange - m_rangeEndMargin) continue;
 					gatherComponent(c);
-					if (rangeEndEvidence(m_component) * (1.0 - nextP) <= logAlphaPooled && runsToRangeEnd(m_component))
+					// The rays first: on the Kinect One's frames most components
+					// fail them, and the evidence's first call fills the rings from
+					// every floor cell of the frame.
+					if (runsToRangeEnd(m_component) && rangeEndEvidence(m_component) * (1.0 - nextP) <= logAlphaPooled)
 					{
 						stats.range_end_regions++;
 						stats.regions++;
