@@ -453,19 +453,14 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 	{
 		const uint32_t k = m_tailCount[d.cell];
 		const ElevationCell& c = frame.cell(d.cell);
-		if (d.kind == TailKind::Deep)
+		if (d.kind == TailKind::Deep || d.kind == TailKind::Raised)
 		{
-			if (k < minRay || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
+			// A ground cell the count makes a drop (deep) or an obstacle (raised).
+			const bool drop = d.kind == TailKind::Deep;
+			if (k < (drop ? minRay : minPoints()) || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
 			// Its ground evidence stays if range_smear takes this back.
-			m_class[d.cell] = VoxelClass::Drop;
-			hold(Held{d.cell, k, true, m_params.drop_rays, true}, smear, frame, stats);
-			continue;
-		}
-		if (d.kind == TailKind::Raised)
-		{
-			if (k < minPoints() || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
-			m_class[d.cell] = VoxelClass::Obstacle;
-			hold(Held{d.cell, k, false, false, true}, smear, frame, stats);
+			m_class[d.cell] = drop ? VoxelClass::Drop : VoxelClass::Obstacle;
+			hold(Held{d.cell, k, drop, drop && m_params.drop_rays, true}, smear, frame, stats);
 			continue;
 		}
 		// An obstacle or a drop judged by its extreme sample: it takes as many
@@ -570,7 +565,8 @@ void InverseSensorModel::compute(
 	// noise is time of flight's alone (raised_sample_test). A camera of unknown
 	// noise (`custom` with no coefficients: a Kinect v1's 640 x 480 at 62.7
 	// deg, structured light) is not taken to have them.
-	const bool timeOfFlight = !sharedNoise && !(m_camera.baseline > 0) && m_camera.independent(1.0, m_fx) > 0;
+	// (No baseline: no disparity term, so no correlated part either.)
+	const bool timeOfFlight = !(m_camera.baseline > 0) && m_camera.independent(1.0, m_fx) > 0;
 	const bool raisedTest = deepTest && m_params.raised_sample_test && timeOfFlight;
 	const bool smear = smearTest();
 	m_tailCandidates.clear();

@@ -712,8 +712,7 @@ void MissingFloorDetector::compute(
 		return u >= -0.5 && u <= K.width - 0.5 && v >= -0.5 && v <= K.height - 0.5;
 	};
 	const auto horizontalDist = [&](uint32_t c) {
-		const double dx = g.cx(int(c % uint32_t(g.nx))) - s.x(), dy = g.cy(int(c / uint32_t(g.nx))) - s.y();
-		return std::sqrt(dx * dx + dy * dy);
+		return std::sqrt(dist2(int(c % uint32_t(g.nx)), int(c / uint32_t(g.nx))));
 	};
 	// Only a region that comes near the end of the range (or of the grid)
 	// can run to it: the walks below are for those.
