@@ -56,6 +56,14 @@ TEST(CameraNoise, TheModelIsFoundFromTheLabelThenTheFrame)
 	// 640x480: 60 deg (fx 554) is an Astra or a Kinect v1 (structured light); a
 	// D400 at 640x480 would be 74 deg wide (fx 426 over 640 px): unknown.
 	EXPECT_EQ(detectCameraModel("", 640, 480, 554.26), CameraModel::Astra);
+	// A Kinect v1 (MRPT labels it KINECT, as the Kinect One): its depth camera
+	// fx 585, 2 atan(320 / 585) = 2 x 28.68 = 57.4 deg; registered to its
+	// colour camera fx 525 (OpenNI, PCL), 2 atan(320 / 525) = 2 x 31.37 = 62.7
+	// deg. Past 64 deg (fx < 320 / tan(32 deg) = 512.1) it is no Astra: fx 505
+	// is 2 atan(0.6337) = 64.7 deg.
+	EXPECT_EQ(detectCameraModel("KINECT", 640, 480, 585), CameraModel::Astra);
+	EXPECT_EQ(detectCameraModel("KINECT", 640, 480, 525), CameraModel::Astra);
+	EXPECT_EQ(detectCameraModel("", 640, 480, 505), CameraModel::Custom);
 	EXPECT_EQ(detectCameraModel("", 640, 480, 426), CameraModel::Custom);
 	EXPECT_EQ(detectCameraModel("", 160, 120, 120), CameraModel::Custom);
 }

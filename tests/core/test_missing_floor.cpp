@@ -251,7 +251,10 @@ TEST(MissingFloor, FloorThatDropsOutOftenIsNotAHole)
 	// A shiny floor: 9 of every 10 pixels return nothing (index % 10 != 0:
 	// with 40 columns only columns 0, 10, 20 and 30 return), and the cell of
 	// rows 0-3, cols 0-3 (x and y cell 14) returns nothing at all. Many cells
-	// (e.g. cols 4-7) get no return either: dropouts, not holes.
+	// (e.g. cols 4-7) get no return either: dropouts, not holes. Columns
+	// 31-39 return nothing in any row: a dead band at the image's right
+	// border (missing::deadBorderColumns), whose 9 x 40 = 360 pixels are no
+	// rays.
 	Scene s;
 	for (int i = 0; i < kSize * kSize; i++)
 		if (i % 10 != 0) s.depth[size_t(i)] = 0;
@@ -259,15 +262,17 @@ TEST(MissingFloor, FloorThatDropsOutOftenIsNotAHole)
 		for (int c = 0; c < 4; c++) s.at(r, c) = 0;
 	Result res;
 	run(s, res);
+	EXPECT_EQ(res.stats.dead_border_columns, 9u);
 	// Valid pixels: i % 10 == 0 gives 160, minus those in rows 0-3, cols 0-3
-	// (i = 0, 40, 80, 120: 4 of them) = 156; empty = 1600 - 156 = 1444.
-	EXPECT_EQ(res.stats.empty_rays, 1444u);
-	// Seen cells: y cells 12 (cols 8-11), 9 (cols 20-23), 7 (cols 28-31) in
-	// all 40 rows and 14 (cols 0-3) in rows 4-39: 3 * 40 * 4 + 36 * 4 = 624
-	// rays, one valid in 4 (156): q = 468 / 624 = 0.75.
-	const double q = 0.75;
+	// (i = 0, 40, 80, 120: 4 of them) = 156; empty = 1600 - 156 - 360 = 1084.
+	EXPECT_EQ(res.stats.empty_rays, 1084u);
+	// Seen cells: y cells 12 (cols 8-11) and 9 (cols 20-23) in all 40 rows,
+	// 7 (cols 28-30 now: 31 is dead) in all rows and 14 (cols 0-3) in rows
+	// 4-39: 2 * 40 * 4 + 40 * 3 + 36 * 4 = 584 rays, 156 valid: q = 428 / 584
+	// = 0.73288.
+	const double q = 428.0 / 584.0;
 	EXPECT_NEAR(res.det.dropoutRate(1.0), q, 1e-12);
-	// 0.75^16 = 0.010 (more with p11 > q): such floor leaves cells empty.
+	// 0.733^16 = 0.0069 (more with p11 > q): such floor leaves cells empty.
 	EXPECT_GT(missing::emptyCellChance(q, -1, 16), 1e-3);
 	EXPECT_EQ(res.det.emptyRays(cellOf(14, 14)), 16);
 	EXPECT_FALSE(res.det.isMissing(cellOf(14, 14)));
@@ -347,13 +352,16 @@ TEST(MissingFloor, WhereTheReturnsStopIsNotAHole)
 
 TEST(MissingFloor, NoSeenFloorAroundMeansNoRegion)
 {
-	// Everything returns nothing: no cell has samples, no cell is Ground, and
-	// the measured dropout rate is 1 (1600 of 1600): nothing is marked.
+	// Everything returns nothing: no cell has samples, no cell is Ground.
+	// Every column is dead (no return in any row): no ray at all, and the
+	// dropout rate is 1 (no evidence): nothing is marked.
 	Scene s;
 	std::fill(s.depth.begin(), s.depth.end(), 0);
 	Result res;
 	run(s, res);
-	EXPECT_EQ(res.stats.empty_rays, 1600u);
+	EXPECT_EQ(res.stats.dead_border_columns, 40u);
+	EXPECT_EQ(res.stats.rays, 0u);
+	EXPECT_EQ(res.stats.empty_rays, 0u);
 	EXPECT_DOUBLE_EQ(res.det.dropoutRate(1.0), 1.0);
 	EXPECT_EQ(res.stats.cells, 0u);
 }
@@ -399,22 +407,32 @@ TEST(MissingFloor, TheStereoInvalidBandIsNoEvidence)
 	// imager: a stereo camera returns nothing there. Their 40 x 4 = 160
 	// pixels fill the 10 cells of y cell 14 ((19.5 - c) / 80 = 0.244 ..
 	// 0.206), 16 rays each.
+	// One pixel of the band, (39, 0), returns the floor: the band is no dead
+	// band (missing::deadBorderColumns), its other 159 pixels are judged.
+	// That pixel meets the floor at x = (19.5 - 39) / 80 = -0.244 (x cell 5),
+	// y cell 14: that cell is seen, the band's 9 others (x cells 6-14) are not.
 	Scene s;
 	for (int r = 0; r < kSize; r++)
 		for (int c = 0; c < 4; c++) s.at(r, c) = 0;
+	s.at(39, 0) = 1000;
 
-	// Read as a time-of-flight camera: 160 empty rays, 10 candidate cells
-	// (none missing: at the edge of the view, no floor beyond them).
+	// Read as a time-of-flight camera: 159 empty rays, 9 candidate cells (16
+	// empty rays each; none missing: at the edge of the view, no floor beyond
+	// them). The seen floor's dropout rate: 15 empty of the 1600 - 9 x 16 =
+	// 1456 rays into seen cells.
 	Result tof;
 	run(s, tof);
+	EXPECT_EQ(tof.stats.dead_border_columns, 0u);
 	EXPECT_EQ(tof.stats.rays, 1600u);
-	EXPECT_EQ(tof.stats.empty_rays, 160u);
-	EXPECT_EQ(tof.stats.candidates, 10u);
+	EXPECT_EQ(tof.stats.empty_rays, 159u);
+	EXPECT_NEAR(tof.det.dropoutRate(1.0), 15.0 / 1456.0, 1e-12);
+	EXPECT_EQ(tof.stats.candidates, 9u);
 
-	// With the baseline those pixels are no rays at all: 1600 - 160 = 1440.
+	// With the baseline the 159 empty pixels are no rays at all: 1600 - 159
+	// = 1441 (the pixel that returned is one).
 	Result stereo;
 	run(s, stereo, {}, 0.05);
-	EXPECT_EQ(stereo.stats.rays, 1440u);
+	EXPECT_EQ(stereo.stats.rays, 1441u);
 	EXPECT_EQ(stereo.stats.empty_rays, 0u);
 	EXPECT_EQ(stereo.stats.candidates, 0u);
 
@@ -428,6 +446,66 @@ TEST(MissingFloor, TheStereoInvalidBandIsNoEvidence)
 	EXPECT_EQ(hole.stats.cells, 4u);
 	EXPECT_TRUE(hole.det.isMissing(cellOf(9, 7)));
 	EXPECT_TRUE(hole.det.isMissing(cellOf(10, 8)));
+}
+
+TEST(MissingFloor, ADeadBandAtTheImagesBorderIsNoEvidence)
+{
+	// A depth image registered to a colour camera: columns 36-39 return
+	// nothing in any row (the depth camera does not see that far right).
+	// Those 4 x 40 = 160 pixels fill the 10 cells of y cell 5 ((19.5 - c) /
+	// 80 = -0.206 .. -0.244), 16 rays each, beside seen floor: read as rays,
+	// they would be 10 candidates. A dead band is no ray at all.
+	Scene s;
+	for (int r = 0; r < kSize; r++)
+		for (int c = 36; c < 40; c++) s.at(r, c) = 0;
+	Result dead;
+	run(s, dead);
+	EXPECT_EQ(dead.stats.dead_border_columns, 4u);
+	EXPECT_EQ(dead.stats.rays, 1440u);
+	EXPECT_EQ(dead.stats.empty_rays, 0u);
+	EXPECT_EQ(dead.stats.candidates, 0u);
+
+	// A dark hole inside the live columns (rows 16-23, columns 24-31: the
+	// hole of DarkHoleInSeenFloorIsMarked) is still a hole: its 4 cells.
+	Scene hole = s;
+	for (int r = 16; r < 24; r++)
+		for (int c = 24; c < 32; c++) hole.at(r, c) = 0;
+	Result h;
+	run(hole, h);
+	EXPECT_EQ(h.stats.empty_rays, 64u);
+	EXPECT_EQ(h.stats.cells, 4u);
+	EXPECT_TRUE(h.det.isMissing(cellOf(9, 7)));
+
+	// A band with one return (row 20, column 39: x cell 9, y cell 5) is not
+	// dead: its other 159 pixels are rays again. That return makes cell (9, 5)
+	// seen floor with 15 empty rays of 16: q = 15 / (1600 - 9 x 16) = 15 /
+	// 1456, and along its rows 20-23 an empty pixel is followed by another in
+	// 11 of 12 pairs (36-37, 37-38 both empty in row 20, 38-39 not; all three
+	// in rows 21-23): p11 = 11 / 12. Each other cell of the band, 16 empty
+	// rays: 15 / 1456 x (11 / 12)^15 = 0.010302 x 0.27114 = 0.0027933 > alpha
+	// = 1e-3: blocky dropouts, no candidate.
+	Scene alive = s;
+	alive.at(20, 39) = 1000;
+	Result a;
+	run(alive, a);
+	EXPECT_EQ(a.stats.dead_border_columns, 0u);
+	EXPECT_EQ(a.stats.rays, 1600u);
+	EXPECT_EQ(a.stats.empty_rays, 159u);
+	EXPECT_NEAR(a.det.dropoutRate(1.0), 15.0 / 1456.0, 1e-12);
+	EXPECT_NEAR(a.det.neighbourDropoutRate(), 11.0 / 12.0, 1e-12);
+	EXPECT_NEAR(missing::emptyCellChance(15.0 / 1456.0, 11.0 / 12.0, 16), 0.0027933, 1e-6);
+	EXPECT_EQ(a.stats.candidates, 0u);
+
+	// Dead columns that do not reach the border (16-19) are evidence: 160
+	// empty rays, the 10 cells of y cell 10 candidates.
+	Scene strip;
+	for (int r = 0; r < kSize; r++)
+		for (int c = 16; c < 20; c++) strip.at(r, c) = 0;
+	Result st;
+	run(strip, st);
+	EXPECT_EQ(st.stats.dead_border_columns, 0u);
+	EXPECT_EQ(st.stats.empty_rays, 160u);
+	EXPECT_EQ(st.stats.candidates, 10u);
 }
 
 TEST(MissingFloor, FloorHiddenFromTheSecondImagerByANearerSurfaceIsNoEvidence)

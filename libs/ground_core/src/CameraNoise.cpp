@@ -77,7 +77,10 @@ CameraModel detectCameraModel(std::string_view label, int width, int height, dou
 	if (size(640, 576) || size(320, 288)) return CameraModel::Femto;
 	if ((size(848, 480) || size(1280, 720) || size(640, 360) || size(424, 240)) && hfov > 80 && hfov < 95)
 		return CameraModel::D435;
-	if ((size(640, 480) || size(320, 240)) && hfov > 55 && hfov < 62) return CameraModel::Astra;
+	// Structured light at 640x480: an Astra (60 deg), a Kinect v1's own depth
+	// image (fx 580-590: 57 deg) or one registered to its colour camera (fx
+	// 525, the OpenNI and PCL default: 62.7 deg).
+	if ((size(640, 480) || size(320, 240)) && hfov > 55 && hfov < 64) return CameraModel::Astra;
 	return CameraModel::Custom;
 }
 

@@ -29,6 +29,25 @@ bool isStepShadow(double edge, double far, double drop, double height, double sl
 	return std::abs((far - edge) * height - drop * edge) <= slack * height;
 }
 
+std::pair<int, int> deadBorderColumns(const RangeImageView& img)
+{
+	// Column by column from each border, every row read (bottom up: the
+	// floor's rows return first); the first column with a return ends the
+	// band. (A column's pixels lie a stride apart, but a band of k columns
+	// reads the same cache lines k times.)
+	const auto returns = [&](int c) {
+		for (int r = img.rows - 1; r >= 0; r--)
+			if (img.data[size_t(r) * img.stride + size_t(c)] != 0) return true;
+		return false;
+	};
+	int left = 0;
+	while (left < img.cols && !returns(left)) left++;
+	if (left == img.cols) return {img.cols, 0};  // no return at all
+	int right = 0;
+	while (!returns(img.cols - 1 - right)) right++;
+	return {left, right};
+}
+
 bool outsideSecondImager(int c, double z, double fxBaseline)
 {
 	// lround(c - d) < 0, i.e. c - d <= -0.5, without a libm call per pixel.
@@ -110,13 +129,13 @@ int candidateRow(
 	return candidates;
 }
 
-// The pixels of one image row that returned nothing within the range (raw 0,
-// or beyond rawInRange), as a list of their columns, in order (room for
-// cols); returns how many. Most pixels have a return: 8 at a time are tested
+// The pixels of one image row, columns [begin, cols), that returned nothing
+// within the range (raw 0, or beyond rawInRange), as a list of their columns,
+// in order (room for cols - begin); returns how many. Most pixels have a return: 8 at a time are tested
 // in one vector, and only the empty ones are visited.
-int emptyColumns(const uint16_t* __restrict raw, int cols, uint16_t rawInRange, int32_t* __restrict list)
+int emptyColumns(const uint16_t* __restrict raw, int begin, int cols, uint16_t rawInRange, int32_t* __restrict list)
 {
-	int n = 0, c = 0;
+	int n = 0, c = begin;
 #if defined(__SSE2__)
 	const __m128i one = _mm_set1_epi16(1), range = _mm_set1_epi16(static_cast<short>(rawInRange)),
 				  zero = _mm_setzero_si128();
@@ -312,8 +331,15 @@ void MissingFloorDetector::compute(
 		if (lo - margin >= double(thrDown)) return RowRays::None;
 		return RowRays::Some;
 	};
+	// The pixels judged: the columns [liveBegin, liveEnd), all but the dead
+	// bands at the image's left and right borders (deadBorderColumns).
+	const std::pair<int, int> dead = missing::deadBorderColumns(img);
+	stats.dead_border_columns = size_t(dead.first + dead.second);
+	const int liveBegin = dead.first, liveEnd = std::max(liveBegin, cols - dead.second), liveCols = liveEnd - liveBegin;
+	// A decimated row's pixels are its columns 0, step, 2 step, ...
+	const int firstDecimated = (liveBegin + step - 1) / step * step;
 	size_t rayCount = 0, emptyCount = 0;  // stats.rays and stats.empty_rays, counted in registers
-	for (int r = 0; r < img.rows; r += step)
+	for (int r = 0; r < img.rows && liveCols > 0; r += step)
 	{
 		const float* __restrict fyRow = projector.rayYRow(r);
 		const float* __restrict fzRow = projector.rayZRow(r);
@@ -432,7 +458,7 @@ void MissingFloorDetector::compute(
 			// Where every ray meets the ground, candidate(c) is statsRow or an
 			// empty pixel: no ray to read.
 			const bool allMeet = rowAll == RowRays::Meet;
-			for (int c = 0; c < cols; c += step)
+			for (int c = firstDecimated; c < liveEnd; c += step)
 				if (allMeet ? statsRow || uint16_t(raw[c] - 1) >= rawInRange : bool(candidate(c)))
 					judgeOne(c);
 				else
@@ -451,7 +477,9 @@ void MissingFloorDetector::compute(
 			// takes the stage down by 12-32 %, speed-and-memory.md). The tests
 			// are written out again here, not shared with countRay() as
 			// lambdas: shared, the stage took 5-10 % longer (2026-11-28).
-			judgeableRow(rays, bounds, fyRow, fzRow, cols, m_rowT.data(), isCandidate, m_rowCell.data());
+			judgeableRow(
+				rays, bounds, fyRow + liveBegin, fzRow + liveBegin, liveCols, m_rowT.data() + liveBegin,
+				isCandidate + liveBegin, m_rowCell.data() + liveBegin);
 			const float* __restrict T = m_rowT.data();
 			const int32_t* __restrict cellOf = m_rowCell.data();
 			const VoxelClass* __restrict cls = classes.data();
@@ -464,7 +492,7 @@ void MissingFloorDetector::compute(
 			int32_t runBin = -1;
 			float runLo = 1.f, runHi = 0.f;
 			uint32_t runRays = 0, runEmpty = 0;
-			for (int c = 0; c < cols; c++)
+			for (int c = liveBegin; c < liveEnd; c++)
 			{
 				const uint16_t v = raw[c];
 				// Not judged, or (countRay()'s first test) no return where the
@@ -530,14 +558,18 @@ void MissingFloorDetector::compute(
 		// isCandidate.
 		const bool listEmpty = rowAll == RowRays::Meet && !statsRow;
 		int32_t* emptyCols = m_rowCell.data();
-		const int candidates =
-			listEmpty ? emptyColumns(raw, cols, rawInRange, emptyCols)
-					  : candidateRow(rays, thrDown, fyRow, fzRow, raw, cols, statsRow, rawInRange, isCandidate);
+		const int candidates = listEmpty ? emptyColumns(raw, liveBegin, liveEnd, rawInRange, emptyCols)
+										 : candidateRow(
+											   rays, thrDown, fyRow + liveBegin, fzRow + liveBegin, raw + liveBegin,
+											   liveCols, statsRow, rawInRange, isCandidate + liveBegin);
 		// Where the rays meet the ground: in a vector loop for the whole row
 		// where candidates are many (a statistics row, a row of dropouts),
 		// else one candidate at a time.
-		const bool wholeRow = 8 * candidates > cols;
-		if (wholeRow) meetGroundRow(rays, fyRow, fzRow, cols, m_rowT.data(), m_rowCx.data(), m_rowCy.data());
+		const bool wholeRow = 8 * candidates > liveCols;
+		if (wholeRow)
+			meetGroundRow(
+				rays, fyRow + liveBegin, fzRow + liveBegin, liveCols, m_rowT.data() + liveBegin,
+				m_rowCx.data() + liveBegin, m_rowCy.data() + liveBegin);
 		const float* T = m_rowT.data();
 		const float* CX = m_rowCx.data();
 		const float* CY = m_rowCy.data();
@@ -588,8 +620,8 @@ void MissingFloorDetector::compute(
 			continue;
 		}
 		// They are few: skip eight pixels without one at a time.
-		int c = 0;
-		for (; c + 8 <= cols; c += 8)
+		int c = liveBegin;
+		for (; c + 8 <= liveEnd; c += 8)
 		{
 			uint64_t eight;
 			std::memcpy(&eight, isCandidate + c, 8);
@@ -604,7 +636,7 @@ void MissingFloorDetector::compute(
 				else
 					prev = 0;
 		}
-		for (; c < cols; c++)
+		for (; c < liveEnd; c++)
 			if (isCandidate[c])
 				judge(c);
 			else
@@ -709,7 +741,8 @@ void MissingFloorDetector::compute(
 		const Eigen::Vector3d q = R.transpose() * (p - s);
 		if (!(q.x() > 0)) return false;
 		const double u = K.cx - K.fx * q.y() / q.x(), v = K.cy - K.fy * q.z() / q.x();
-		return u >= -0.5 && u <= K.width - 0.5 && v >= -0.5 && v <= K.height - 0.5;
+		// (The live columns: a dead band at a border is no view.)
+		return u >= liveBegin - 0.5 && u <= liveEnd - 0.5 && v >= -0.5 && v <= K.height - 0.5;
 	};
 	const auto horizontalDist = [&](uint32_t c) {
 		return std::sqrt(dist2(int(c % uint32_t(g.nx)), int(c / uint32_t(g.nx))));

@@ -56,7 +56,8 @@ CameraNoise cameraNoisePreset(CameraModel model);
  * size and horizontal field of view: 512x424 Kinect One; 640x576 or 320x288
  * Femto (narrow mode); 848x480, 1280x720, 640x360 and 424x240 at 80-95 deg
  * D435 (the noisier of the two D400 models the map knows); 640x480 or 320x240
- * at 55-62 deg Astra (structured light, as a Kinect v1). Custom when nothing
+ * at 55-64 deg Astra (structured light, as a Kinect v1: 57 deg, 62.7 deg
+ * registered to its colour camera). Custom when nothing
  * matches: a frame of unknown noise (the mapper says so). */
 CameraModel detectCameraModel(std::string_view label, int width, int height, double fx);
 

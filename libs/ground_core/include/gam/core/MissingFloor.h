@@ -27,6 +27,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "gam/core/DepthProjector.h"
@@ -120,9 +121,10 @@ struct MissingFloorStats
 	size_t pooled_regions = 0;  ///< regions kept on their weak candidates' evidence together
 	size_t range_end_regions =
 		0;  ///< components of unbordered regions kept as a step's shadow that runs to the end of the range (rule MF11)
-	size_t blocking = 0;       ///< missing cells within block_range
-	size_t under_patches = 0;  ///< cells of bordered regions left out: a ramp or landing patch applies there
-	bool applied = false;      ///< the stage ran on this frame
+	size_t blocking = 0;             ///< missing cells within block_range
+	size_t under_patches = 0;        ///< cells of bordered regions left out: a ramp or landing patch applies there
+	size_t dead_border_columns = 0;  ///< image columns at the left and right borders with no return in the frame
+	bool applied = false;            ///< the stage ran on this frame
 };
 
 namespace missing
@@ -141,6 +143,17 @@ double emptyCellChance(double q, double p11, int n);
  * edge, fx baseline / z pixels wide. Such a pixel returns nothing whatever
  * lies there. */
 bool outsideSecondImager(int c, double z, double fxBaseline);
+
+/** The dead bands at an image's borders: how many columns from the left
+ * border, and from the right one, hold no return (raw 0) in any row. A
+ * depth image registered to a colour camera (a Kinect v1's or an OpenNI
+ * camera's, as PCL and ROS publish them) has such bands where the depth
+ * camera's view does not cover the colour camera's; empty pixels there say
+ * nothing about the floor. A hole or a drop empties a whole column only
+ * where nothing else stands within the range in that column either: the
+ * column's upper rows look past the hole at what lies beyond. ({cols, 0}
+ * for an image without a single return.) */
+std::pair<int, int> deadBorderColumns(const RangeImageView& img);
 
 /** Whether a gap in the floor is the shadow of a step down: seen floor ends
  * at the edge, `edge` from the sensor (2D), which is `height` above the
