@@ -64,6 +64,11 @@ TEST(CameraNoise, TheModelIsFoundFromTheLabelThenTheFrame)
 	EXPECT_EQ(detectCameraModel("KINECT", 640, 480, 585), CameraModel::Astra);
 	EXPECT_EQ(detectCameraModel("KINECT", 640, 480, 525), CameraModel::Astra);
 	EXPECT_EQ(detectCameraModel("", 640, 480, 505), CameraModel::Custom);
+	// PrimeSense's structured light by its label, whatever the mode: MRPT's
+	// COpenNI2Sensor frames (OPENNI2), an Xtion at 160x120.
+	EXPECT_EQ(detectCameraModel("OPENNI2", 640, 480, 505), CameraModel::Astra);
+	EXPECT_EQ(detectCameraModel("Xtion_front", 160, 120, 120), CameraModel::Astra);
+	EXPECT_EQ(detectCameraModel("KINECT_V1", 0, 0, 0), CameraModel::Astra);
 	EXPECT_EQ(detectCameraModel("", 640, 480, 426), CameraModel::Custom);
 	EXPECT_EQ(detectCameraModel("", 160, 120, 120), CameraModel::Custom);
 }

@@ -69,7 +69,11 @@ CameraModel detectCameraModel(std::string_view label, int width, int height, dou
 	if (has("d455")) return CameraModel::D455;
 	if (has("d435") || has("realsense")) return CameraModel::D435;
 	if (has("femto") || has("azure")) return CameraModel::Femto;
-	if (has("astra")) return CameraModel::Astra;
+	// PrimeSense's structured light (PS1080 and its heirs): the Astra, the
+	// Asus Xtion and PrimeSense Carmine, a Kinect v1; OpenNI drives them.
+	if (has("astra") || has("xtion") || has("primesense") || has("carmine") || has("openni") || has("kinect_v1") ||
+		has("kinect1") || has("kinectv1"))
+		return CameraModel::Astra;
 	if (has("kinect_one") || has("kinectone") || has("kinect2") || has("kinect_v2")) return CameraModel::KinectOne;
 	const double hfov = fx > 0 && width > 0 ? 2.0 * std::atan(0.5 * width / fx) * 180.0 / M_PI : 0.0;
 	auto size = [&](int w, int h) { return width == w && height == h; };

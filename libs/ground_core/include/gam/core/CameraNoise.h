@@ -52,7 +52,10 @@ struct CameraNoise
 CameraNoise cameraNoisePreset(CameraModel model);
 
 /** The model a frame comes from, guessed from its sensor label (case-blind:
- * "d435", "d455", "femto", "azure", "astra", "kinect"), else from its image
+ * "d455"; "d435" or "realsense"; "femto" or "azure"; "astra", "xtion",
+ * "primesense", "carmine", "openni", "kinect_v1", "kinect1" or "kinectv1"
+ * (structured light); "kinect_one", "kinectone", "kinect2" or "kinect_v2"),
+ * else from its image
  * size and horizontal field of view: 512x424 Kinect One; 640x576 or 320x288
  * Femto (narrow mode); 848x480, 1280x720, 640x360 and 424x240 at 80-95 deg
  * D435 (the noisier of the two D400 models the map knows); 640x480 or 320x240
