@@ -31,6 +31,24 @@ struct Scene
 	uint16_t& at(int r, int c) { return depth[size_t(r) * kSize + size_t(c)]; }
 };
 
+/** The floor with columns [from, to) returning nothing in every row. */
+Scene emptyColumns(int from, int to)
+{
+	Scene s;
+	for (int r = 0; r < kSize; r++)
+		for (int c = from; c < to; c++) s.at(r, c) = 0;
+	return s;
+}
+
+/** The 8 x 8 pixel hole of DarkHoleInSeenFloorIsMarked (rows 16-23,
+ * columns 24-31: x cells 9-10, y cells 7-8), each pixel set to `value` (0: no
+ * return). */
+void addDarkHole(Scene& s, uint16_t value = 0)
+{
+	for (int r = 16; r < 24; r++)
+		for (int c = 24; c < 32; c++) s.at(r, c) = value;
+}
+
 struct Result
 {
 	MissingFloorDetector det;
@@ -159,8 +177,7 @@ TEST(MissingFloor, DarkHoleInSeenFloorIsMarked)
 	// -0.05625 .. -0.09375 for cols 24-27 (floor(8.875) .. floor(8.125) = 8)
 	// and -0.10625 .. -0.14375 for cols 28-31 (7).
 	Scene s;
-	for (int r = 16; r < 24; r++)
-		for (int c = 24; c < 32; c++) s.at(r, c) = 0;
+	addDarkHole(s);
 	Result res;
 	MissingFloorParams p;
 	// The hole's cells are at 2D distances sqrt(0.025^2 + 0.075^2) = 0.079 m
@@ -199,8 +216,7 @@ TEST(MissingFloor, NoMissingFloorWhereARampPatchApplies)
 	// a table 5 blocks wide. It covers the hole's y = 7 cells; the y = 8
 	// cells lie in block (2, 2), which no patch covers.
 	Scene s;
-	for (int r = 16; r < 24; r++)
-		for (int c = 24; c < 32; c++) s.at(r, c) = 0;
+	addDarkHole(s);
 	std::vector<uint8_t> blocks(25, 0);
 	blocks[7] = 1;
 	const PatchSupport patches{blocks.data(), blocks.size(), 4, 5, 20};
@@ -232,8 +248,7 @@ TEST(MissingFloor, OutsideTheFieldOfViewIsNotMarked)
 	// grid's outer ring (e.g. cell (0, 0) at -0.475, -0.475) gets no ray at all,
 	// so nothing can be said there, even with a dark hole inside the view.
 	Scene s;
-	for (int r = 16; r < 24; r++)
-		for (int c = 24; c < 32; c++) s.at(r, c) = 0;
+	addDarkHole(s);
 	Result res;
 	run(s, res);
 	for (int ix = 0; ix < 20; ix++)
@@ -322,8 +337,7 @@ TEST(MissingFloor, ReturnsFarBelowTheFloorCountAsNoFloor)
 	// floor) -> empty rays: rows 16-23 and cols 24-31 are x cells 9, 10 and
 	// y cells 7, 8 (as the dark hole above).
 	Scene s;
-	for (int r = 16; r < 24; r++)
-		for (int c = 24; c < 32; c++) s.at(r, c) = 6000;
+	addDarkHole(s, 6000);
 	Result res;
 	run(s, res);
 	EXPECT_EQ(res.stats.empty_rays, 64u);
@@ -411,9 +425,7 @@ TEST(MissingFloor, TheStereoInvalidBandIsNoEvidence)
 	// band (missing::deadBorderColumns), its other 159 pixels are judged.
 	// That pixel meets the floor at x = (19.5 - 39) / 80 = -0.244 (x cell 5),
 	// y cell 14: that cell is seen, the band's 9 others (x cells 6-14) are not.
-	Scene s;
-	for (int r = 0; r < kSize; r++)
-		for (int c = 0; c < 4; c++) s.at(r, c) = 0;
+	Scene s = emptyColumns(0, 4);
 	s.at(39, 0) = 1000;
 
 	// Read as a time-of-flight camera: 159 empty rays, 9 candidate cells (16
@@ -438,8 +450,7 @@ TEST(MissingFloor, TheStereoInvalidBandIsNoEvidence)
 
 	// A dark hole the second imager does see (rows 16-23, columns 24-31: the
 	// hole of DarkHoleInSeenFloorIsMarked) is still a hole: its 4 cells.
-	for (int r = 16; r < 24; r++)
-		for (int c = 24; c < 32; c++) s.at(r, c) = 0;
+	addDarkHole(s);
 	Result hole;
 	run(s, hole, {}, 0.05);
 	EXPECT_EQ(hole.stats.empty_rays, 64u);
@@ -455,9 +466,7 @@ TEST(MissingFloor, ADeadBandAtTheImagesBorderIsNoEvidence)
 	// Those 4 x 40 = 160 pixels fill the 10 cells of y cell 5 ((19.5 - c) /
 	// 80 = -0.206 .. -0.244), 16 rays each, beside seen floor: read as rays,
 	// they would be 10 candidates. A dead band is no ray at all.
-	Scene s;
-	for (int r = 0; r < kSize; r++)
-		for (int c = 36; c < 40; c++) s.at(r, c) = 0;
+	Scene s = emptyColumns(36, 40);
 	Result dead;
 	run(s, dead);
 	EXPECT_EQ(dead.stats.dead_border_columns, 4u);
@@ -468,8 +477,7 @@ TEST(MissingFloor, ADeadBandAtTheImagesBorderIsNoEvidence)
 	// A dark hole inside the live columns (rows 16-23, columns 24-31: the
 	// hole of DarkHoleInSeenFloorIsMarked) is still a hole: its 4 cells.
 	Scene hole = s;
-	for (int r = 16; r < 24; r++)
-		for (int c = 24; c < 32; c++) hole.at(r, c) = 0;
+	addDarkHole(hole);
 	Result h;
 	run(hole, h);
 	EXPECT_EQ(h.stats.empty_rays, 64u);
@@ -498,9 +506,7 @@ TEST(MissingFloor, ADeadBandAtTheImagesBorderIsNoEvidence)
 
 	// Dead columns that do not reach the border (16-19) are evidence: 160
 	// empty rays, the 10 cells of y cell 10 candidates.
-	Scene strip;
-	for (int r = 0; r < kSize; r++)
-		for (int c = 16; c < 20; c++) strip.at(r, c) = 0;
+	Scene strip = emptyColumns(16, 20);
 	Result st;
 	run(strip, st);
 	EXPECT_EQ(st.stats.dead_border_columns, 0u);
