@@ -190,6 +190,9 @@ TEST(RealData, TheBandsOfADepthImageRegisteredToColourAreNoMissingFloor)
 			  << "\n";
 	EXPECT_GE(m.dead_border_columns, 20u);
 	EXPECT_EQ(m.cells, 0u);
+	// The camera's summary carries them (the mapper prints them).
+	ASSERT_EQ(g.cameras().size(), 1u);
+	EXPECT_EQ(size_t(g.cameras().begin()->second.dead_border_columns), m.dead_border_columns);
 }
 
 TEST(RealData, AscendingStairsAreObstacles)

@@ -167,6 +167,11 @@ const bool kTraitsRegistered = [] {
 						: (pp.camera.model == gam::CameraModel::Auto ? " (auto)" : ""),
 				cam.width, cam.height_px, cam.height, trust.c_str(), pp.ism.traversable_step, pp.ism.noise_sigmas);
 			out += (out.empty() ? "" : "\n") + std::string(b);
+			if (cam.dead_border_columns > 0)
+				out += mrpt::format(
+					"; %d image columns at its borders returned nothing in any row of its last frame (the band of a "
+					"depth image registered to colour, or of a stereo camera): no floor evidence there",
+					cam.dead_border_columns);
 		}
 		return out;
 	};
@@ -724,6 +729,7 @@ bool CGroundAwareOccupancyGrid::insert3D(const mrpt::obs::CObservation& obs, con
 		cam.height = frame.sensor_position.z() - robotPose.z();
 		cam.width = frame.intrinsics.width;
 		cam.height_px = frame.intrinsics.height;
+		cam.dead_border_columns = int(res.missing.dead_border_columns);
 	}
 	if (m_options.mount.enabled)
 	{

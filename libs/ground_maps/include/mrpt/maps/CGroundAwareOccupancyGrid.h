@@ -214,6 +214,10 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		double trust_range = 0;  ///< [m]; +inf when not limited
 		double height = 0;       ///< sensor above the robot's floor [m]
 		int width = 0, height_px = 0;
+		/** Image columns at the left and right borders that returned nothing in
+		 * any row of the last frame (a depth image registered to a colour
+		 * camera): no floor evidence there (missing::deadBorderColumns). */
+		int dead_border_columns = 0;
 	};
 	const std::map<std::string, TCameraInfo>& cameras() const { return m_cameras; }
 	/** The ramp patches that the depth frames of sensor `label` fitted, as
