@@ -48,7 +48,65 @@ Census census(const CGroundAwareOccupancyGrid& g)
 	}
 	return c;
 }
+// The frame's own samples against the map, cell by cell, where the map has
+// evidence: a cell whose samples (at least 5) all lie within 3 cm of the floor
+// (z = 0 by the dataset's floor fit, residual std about 1 cm) is floor; one
+// whose samples all lie 0.15-1.2 m up is an object (as the real RealSense
+// test does with its own points).
+struct PointCensus
+{
+	size_t floorKnown = 0, floorOcc = 0, objectKnown = 0, objectOcc = 0;
+};
+PointCensus pointCensus(const CGroundAwareOccupancyGrid& g)
+{
+	PointCensus c;
+	const auto& fr = g.lastFrameElevation();
+	const auto& geo = fr.geometry();
+	for (uint32_t i : fr.observedCells())
+	{
+		const auto& cell = fr.cell(i);
+		const double x = geo.cx(int(i % uint32_t(geo.nx))), y = geo.cy(int(i / uint32_t(geo.nx)));
+		const double p = pOcc(g, x, y);
+		if (cell.count < 5 || std::abs(p - 0.5) < 1e-3) continue;  // too few samples, or no evidence
+		if (cell.z_min >= -0.03f && cell.z_max <= 0.03f)
+		{
+			c.floorKnown++;
+			c.floorOcc += p > 0.5;
+		}
+		else if (cell.z_min >= 0.15f && cell.z_max <= 1.2f)
+		{
+			c.objectKnown++;
+			c.objectOcc += p > 0.5;
+		}
+	}
+	return c;
+}
 }  // namespace
+
+TEST(RealData, KinectV1FramesFloorFreeObjectsMarked)
+{
+	// PCL's three Kinect v1 frames, read as structured light (`auto`: 640x480
+	// at 62.7 deg). Issue #27 asks a real frame's floor to be <= 1 % occupied.
+	// (Read as a camera of unknown noise, before 2026-11-29, the corridor's
+	// floor was 36 of 821 cells occupied, the office's 8 of 505.)
+	for (const char* rel :
+		 {"pcl_milk_bottles_on_carpet/pcl_milk_bottles_on_carpet.rawlog", "pcl_office1/pcl_office1.rawlog",
+		  "pcl_five_people_corridor/pcl_five_people_corridor.rawlog"})
+	{
+		auto o = firstScan(rel);
+		if (!o) GTEST_SKIP() << "real data not found: " << realData(rel);
+		CGroundAwareOccupancyGrid g;
+		g.insertObservation(*o);
+		const PointCensus c = pointCensus(g);
+		std::cout << "[real] " << rel << ": floor cells " << c.floorOcc << " of " << c.floorKnown
+				  << " occupied, object cells " << c.objectOcc << " of " << c.objectKnown << "\n";
+		EXPECT_EQ(g.cameras().begin()->second.model, gam::CameraModel::Astra) << rel;
+		ASSERT_GT(c.floorKnown, 100u) << rel;
+		EXPECT_LE(double(c.floorOcc), 0.01 * double(c.floorKnown)) << rel;
+		ASSERT_GE(c.objectKnown, 4u) << rel;
+		EXPECT_GE(double(c.objectOcc), 0.9 * double(c.objectKnown)) << rel;
+	}
+}
 
 TEST(RealData, MrptFloorScanGroundMatchesTheStoredPose)
 {
