@@ -37,7 +37,7 @@ std::pair<int, int> deadBorderColumns(const RangeImageView& img)
 	// reads the same cache lines k times.)
 	const auto returns = [&](int c) {
 		for (int r = img.rows - 1; r >= 0; r--)
-			if (img.data[size_t(r) * img.stride + size_t(c)] != 0) return true;
+			if (img.at(r, c) != 0) return true;
 		return false;
 	};
 	int left = 0;
@@ -129,17 +129,18 @@ int candidateRow(
 	return candidates;
 }
 
-// The pixels of one image row, columns [begin, cols), that returned nothing
+// The pixels of one image row, columns [begin, end), that returned nothing
 // within the range (raw 0, or beyond rawInRange), as a list of their columns,
-// in order (room for cols - begin); returns how many. Most pixels have a return: 8 at a time are tested
-// in one vector, and only the empty ones are visited.
-int emptyColumns(const uint16_t* __restrict raw, int begin, int cols, uint16_t rawInRange, int32_t* __restrict list)
+// in order (room for end - begin); returns how many. Most pixels have a
+// return: 8 at a time are tested in one vector, and only the empty ones are
+// visited.
+int emptyColumns(const uint16_t* __restrict raw, int begin, int end, uint16_t rawInRange, int32_t* __restrict list)
 {
 	int n = 0, c = begin;
 #if defined(__SSE2__)
 	const __m128i one = _mm_set1_epi16(1), range = _mm_set1_epi16(static_cast<short>(rawInRange)),
 				  zero = _mm_setzero_si128();
-	for (; c + 8 <= cols; c += 8)
+	for (; c + 8 <= end; c += 8)
 	{
 		// raw - 1 >= rawInRange (unsigned, 0 wraps to 65535): rawInRange - (raw - 1) saturates at 0.
 		const __m128i v = _mm_sub_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(raw + c)), one);
@@ -148,7 +149,7 @@ int emptyColumns(const uint16_t* __restrict raw, int begin, int cols, uint16_t r
 			list[n++] = c + __builtin_ctz(mask);
 	}
 #endif
-	for (; c < cols; c++)
+	for (; c < end; c++)
 		if (uint16_t(raw[c] - 1) >= rawInRange) list[n++] = c;
 	return n;
 }

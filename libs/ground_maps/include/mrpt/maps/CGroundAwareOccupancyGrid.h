@@ -215,8 +215,9 @@ class CGroundAwareOccupancyGrid : public COccupancyGridMap2D
 		double height = 0;       ///< sensor above the robot's floor [m]
 		int width = 0, height_px = 0;
 		/** Image columns at the left and right borders that returned nothing in
-		 * any row of the last frame (a depth image registered to a colour
-		 * camera): no floor evidence there (missing::deadBorderColumns). */
+		 * any row of the last frame (the band of a depth image registered to a
+		 * colour camera, or a stereo camera's invalid band): no floor evidence
+		 * there (missing::deadBorderColumns). */
 		int dead_border_columns = 0;
 	};
 	const std::map<std::string, TCameraInfo>& cameras() const { return m_cameras; }
