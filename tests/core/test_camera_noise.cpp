@@ -41,8 +41,8 @@ TEST(CameraNoise, PresetsFromTheMakersFigures)
 	const CameraNoise astra = cameraNoisePreset(CameraModel::Astra);
 	EXPECT_NEAR(astra.independent(2.0, 554.26), 0.007578, 2e-6);
 	EXPECT_NEAR(astra.correlated(2.0, 554.26), 0.002887, 2e-6);
-	// Femto: twice the Kinect One, 8.6 mm at 4 m.
-	EXPECT_NEAR(cameraNoisePreset(CameraModel::Femto).independent(4.0, 504), 0.0086, 1e-12);
+	// Femto: the Kinect v2 form as the Kinect One, 1.5 - 0.5*4 + 0.3*16 = 4.3 mm at 4 m.
+	EXPECT_NEAR(cameraNoisePreset(CameraModel::Femto).independent(4.0, 504), 0.0043, 1e-12);
 }
 
 TEST(CameraNoise, TheModelIsFoundFromTheLabelThenTheFrame)

@@ -49,13 +49,13 @@ TEST(SimCameras, PresetsFollowTheMakersFigures)
 	EXPECT_NEAR(astra.fx(), 554.26, 0.01);
 	EXPECT_NEAR(astra.sigma(2.0, 0.0), 0.00733, 1e-5);
 	EXPECT_EQ(astra.max_range, 4.0);
-	// Femto: 640x576, 75 x 65 deg; time of flight: twice the Kinect v2 form,
-	// 2 * (1.5 - 0.5*2 + 0.3*4) mm = 2 * 1.7 = 3.4 mm at 2 m (the maker's bound is 17 mm).
+	// Femto: 640x576, 75 x 65 deg; time of flight: the Kinect v2 form,
+	// 1.5 - 0.5*2 + 0.3*4 = 1.7 mm at 2 m (the maker's bound is 17 mm).
 	const KinectParams femto = cameraPreset(CameraModel::Femto);
 	EXPECT_EQ(femto.width, 640);
 	EXPECT_EQ(femto.height, 576);
 	EXPECT_FALSE(femto.fromDisparity());
-	EXPECT_NEAR(femto.sigma(2.0, 0.0), 3.4e-3, 1e-9);
+	EXPECT_NEAR(femto.sigma(2.0, 0.0), 1.7e-3, 1e-9);
 	EXPECT_NEAR(2 * std::atan(0.5 * femto.height / femto.fy()) / kDeg, 65.0, 1e-9);
 	// the Kinect One preset is the default
 	const KinectParams k1 = cameraPreset(CameraModel::KinectOne), def;
@@ -269,7 +269,7 @@ TEST(SimCameras, TimeOfFlightMultipathPushesTheFloorAwayAtAWallsFoot)
 		checked++;
 	}
 	EXPECT_GT(checked, 100u);
-	EXPECT_EQ(sigmaScale, 2.0);
+	EXPECT_EQ(sigmaScale, 1.0);  // the Kinect v2 form at its own scale
 }
 
 TEST(SimCameras, ACameraWithoutALabelIsLabelledAfterItsModel)

@@ -36,10 +36,11 @@ CameraNoise cameraNoisePreset(CameraModel model)
 			n.tof_c2 = 0.0003;
 			break;
 		case CameraModel::Femto:
-			// the Kinect v2 form at twice its scale (maker's bound: <= 17 mm)
-			n.tof_c0 = 0.0030;
-			n.tof_c1 = -0.0010;
-			n.tof_c2 = 0.0006;
+			// the Kinect v2 form (maker's bound: <= 17 mm; measured comparable
+			// to the Kinect v2's or lower, doc/cameras.md)
+			n.tof_c0 = 0.0015;
+			n.tof_c1 = -0.0005;
+			n.tof_c2 = 0.0003;
 			break;
 		case CameraModel::D435:
 		case CameraModel::D455:
