@@ -143,7 +143,10 @@ struct NavBenchOptions
 	int jobs = 1;              ///< runs in parallel (threads)
 	int figureScenes = 3;      ///< the first seeds drawn in trajectories.png
 	bool writeScenes = false;  ///< DIR/scenes/seed_N.scene
-	bool saveMaps = false;     ///< DIR/maps/seed_N_<map>.png (BenchOptions::mapPictureDir)
+	/** > 0: the written scenes drive this far from the start toward the goal,
+	 * a frame every 0.1 m (the held-out protocol: 1.5); 0: the start pose. */
+	double writeScenesPath = 0;
+	bool saveMaps = false;  ///< DIR/maps/seed_N_<map>.png (BenchOptions::mapPictureDir)
 	BenchOptions bench;
 };
 

@@ -184,3 +184,39 @@ TEST(SceneGenerator, BlockedCellsGrowByTheRadius)
 	ASSERT_TRUE(p.found);
 	EXPECT_GT(p.length, 0.8 - 1e-6);
 }
+
+TEST(SceneGenerator, TheHeldOutApproachPathDrivesTowardTheGoal)
+{
+	// The written scene's path is the start pose alone (one depth frame); the
+	// held-out protocol drives 1.5 m from it straight toward the goal, a frame
+	// every 0.1 m: 1.5 / 0.1 + 1 = 16 poses, 0.1 m apart, every one facing the
+	// goal (the yaw is written to 0.01 deg, the positions to 1 mm).
+	const GeneratedScene g = generateScene(3005);
+	std::istringstream one(g.text);
+	EXPECT_EQ(samplePath(parseScene(one, "seed_3005").path).size(), 1u);
+
+	std::istringstream in(withApproachPath(g, 1.5));
+	const std::vector<Pose2> poses = samplePath(parseScene(in, "seed_3005 (1.5 m)").path);
+	ASSERT_EQ(poses.size(), 16u);
+	EXPECT_NEAR(poses.front().x, g.start.x(), 1e-3);
+	EXPECT_NEAR(poses.front().y, g.start.y(), 1e-3);
+	const double heading = std::atan2(g.goal.y() - g.start.y(), g.goal.x() - g.start.x());
+	EXPECT_NEAR(std::hypot(poses.back().x - poses.front().x, poses.back().y - poses.front().y), 1.5, 2e-3);
+	EXPECT_NEAR(std::atan2(poses.back().y - poses.front().y, poses.back().x - poses.front().x), heading, 2e-3);
+	for (size_t i = 1; i < poses.size(); i++)
+	{
+		EXPECT_NEAR(std::hypot(poses[i].x - poses[i - 1].x, poses[i].y - poses[i - 1].y), 0.1, 2e-4);
+		EXPECT_NEAR(poses[i].yaw, heading, 0.01 * M_PI / 180 + 1e-9);
+	}
+	// Everything but the path line is the scene as generated.
+	const std::string a = g.text, b = withApproachPath(g, 1.5);
+	const size_t pa = a.find("\npath "), pb = b.find("\npath ");
+	EXPECT_EQ(a.substr(0, pa), b.substr(0, pb));
+	EXPECT_EQ(a.substr(a.find('\n', pa + 1)), b.substr(b.find('\n', pb + 1)));
+
+	EXPECT_THROW(withApproachPath(g, 0), std::invalid_argument);
+	EXPECT_THROW(withApproachPath(g, 1.5, 0), std::invalid_argument);
+	GeneratedScene noPath = g;
+	noPath.text = "wall id=1 x0=0 y0=0 x1=1 y1=0\n";
+	EXPECT_THROW(withApproachPath(noPath, 1.5), std::invalid_argument);
+}

@@ -557,6 +557,31 @@ GeneratedScene generateScene(unsigned seed, const GeneratorOptions& opts)
 		std::to_string(opts.maxAttempts) + " attempts for seed " + std::to_string(seed));
 }
 
+std::string withApproachPath(const GeneratedScene& g, double metres, double spacing)
+{
+	if (!(metres > 0) || !(spacing > 0) || !std::isfinite(metres) || !std::isfinite(spacing))
+		throw std::invalid_argument("approach path: metres and spacing must be > 0");
+	const std::string key = "\npath waypoints=";
+	const size_t at = g.text.find(key);
+	const size_t end = at == std::string::npos ? at : g.text.find('\n', at + 1);
+	if (end == std::string::npos) throw std::invalid_argument("approach path: the scene has no path line");
+	// The file holds the ends to 1 mm; the frames split the segment between
+	// the rounded ends into n equal steps. samplePath takes ceil(length /
+	// spacing) steps, so the spacing written is that step rounded up (to
+	// 1e-6 m): n steps, never n + 1 for a segment a rounding longer.
+	const auto mm = [](double v) { return std::round(v * 1000.0) / 1000.0; };
+	const Eigen::Vector2d dir = (g.goal - g.start).normalized();
+	const Eigen::Vector2d from(mm(g.start.x()), mm(g.start.y()));
+	const Eigen::Vector2d to(mm(g.start.x() + metres * dir.x()), mm(g.start.y() + metres * dir.y()));
+	const int n = std::max(1, int(std::lround(metres / spacing)));
+	const double step = std::ceil((to - from).norm() / n * 1e6) / 1e6;
+	const double yawDeg = g.startYaw / kDeg;
+	const std::string line =
+		fmt("path waypoints=%.3f,%.3f,%.2f;%.3f,%.3f,%.2f spacing=%.6f", from.x(), from.y(), yawDeg, to.x(), to.y(),
+			yawDeg, step);
+	return g.text.substr(0, at + 1) + line + g.text.substr(end);
+}
+
 void writeGeneratedScene(const GeneratedScene& g, const std::string& file)
 {
 	std::ofstream f(file);

@@ -85,6 +85,14 @@ GeneratedScene generateScene(unsigned seed, const GeneratorOptions& opts = {});
  * start, goal and hazards are in its header comments). Throws on failure. */
 void writeGeneratedScene(const GeneratedScene& g, const std::string& file);
 
+/** g.text with its path line (the start pose alone: one depth frame) replaced
+ * by a drive of `metres` from the start straight toward the goal, facing it,
+ * in round(metres / spacing) equal steps of about `spacing` (the ends are
+ * written to 1 mm): the held-out protocol of doc/benchmark.md (1.5 m, 0.1 m:
+ * 16 frames). Throws std::invalid_argument unless metres > 0
+ * and spacing > 0, or if the text has no such path line. */
+std::string withApproachPath(const GeneratedScene& g, double metres, double spacing = 0.1);
+
 /** The scene without the objects that appear, leave or move (people). */
 Scene staticPart(const Scene& scene);
 
