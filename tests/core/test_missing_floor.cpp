@@ -137,6 +137,20 @@ void run(
 
 uint32_t cellOf(int ix, int iy) { return uint32_t(iy * 20 + ix); }
 
+/** With the hole of addDarkHole() cut into `scene`, run() still finds it:
+ * its 64 empty pixels, its 4 cells (x 9-10, y 7-8) missing floor, whatever
+ * else the scene leaves out of the evidence. */
+void expectTheDarkHoleFound(Scene scene, double baseline = 0)
+{
+	addDarkHole(scene);
+	Result hole;
+	run(scene, hole, {}, baseline);
+	EXPECT_EQ(hole.stats.empty_rays, 64u);
+	EXPECT_EQ(hole.stats.cells, 4u);
+	EXPECT_TRUE(hole.det.isMissing(cellOf(9, 7)));
+	EXPECT_TRUE(hole.det.isMissing(cellOf(10, 8)));
+}
+
 /** The floor as run()'s camera sees it in a range image (MRPT's
  * range_is_depth = false: each pixel the distance along its ray, in mm): the
  * ray (1, a, b) of pixel (r, c), a = (19.5 - r) / 80 and b = (19.5 - c) / 80,
@@ -450,13 +464,7 @@ TEST(MissingFloor, TheStereoInvalidBandIsNoEvidence)
 
 	// A dark hole the second imager does see (rows 16-23, columns 24-31: the
 	// hole of DarkHoleInSeenFloorIsMarked) is still a hole: its 4 cells.
-	addDarkHole(s);
-	Result hole;
-	run(s, hole, {}, 0.05);
-	EXPECT_EQ(hole.stats.empty_rays, 64u);
-	EXPECT_EQ(hole.stats.cells, 4u);
-	EXPECT_TRUE(hole.det.isMissing(cellOf(9, 7)));
-	EXPECT_TRUE(hole.det.isMissing(cellOf(10, 8)));
+	expectTheDarkHoleFound(s, 0.05);
 }
 
 TEST(MissingFloor, ADeadBandAtTheImagesBorderIsNoEvidence)
@@ -476,13 +484,7 @@ TEST(MissingFloor, ADeadBandAtTheImagesBorderIsNoEvidence)
 
 	// A dark hole inside the live columns (rows 16-23, columns 24-31: the
 	// hole of DarkHoleInSeenFloorIsMarked) is still a hole: its 4 cells.
-	Scene hole = s;
-	addDarkHole(hole);
-	Result h;
-	run(hole, h);
-	EXPECT_EQ(h.stats.empty_rays, 64u);
-	EXPECT_EQ(h.stats.cells, 4u);
-	EXPECT_TRUE(h.det.isMissing(cellOf(9, 7)));
+	expectTheDarkHoleFound(s);
 
 	// A band with one return (row 20, column 39: x cell 9, y cell 5) is not
 	// dead: its other 159 pixels are rays again. That return makes cell (9, 5)
