@@ -728,3 +728,45 @@ TEST(RrtNearestPoint, FindsTheNearestAndBreaksTiesTowardTheLowestIndex)
 	EXPECT_EQ(PointSet(12, {{0, 3.f, 4.f}, {4, 0.f, 2.f}, {8, 1.f, 1.f}, {5, 0.f, -1.5f}}).nearest(d2), 8u);
 	EXPECT_EQ(d2, 2.f);
 }
+
+TEST(RrtFloorTest, TheFloorHoldsMoreNodesOnlyBeyondThreeSigmaOfMcNemarsDifference)
+{
+	// Nodes along y = 0 every 0.1 m. The plane z = 0.05 x (2.9 deg) against
+	// the floor z = 0, each holding the nodes within 2.5 cm of it.
+	// The plane's unit normal is (-0.05, 0, 1) / sqrt(1.0025), so a node on
+	// the floor at x lies 0.05 x / 1.00125 from it: within 2.5 cm for
+	// x <= 0.50063, i.e. x = 0.0 ... 0.5, six nodes. A node on the plane at
+	// x lies 0.05 x from the floor: within 2.5 cm for x <= 0.5 (the same six).
+	const Plane plane = [] {
+		const double n = std::sqrt(1.0 + 0.05 * 0.05);
+		return Plane{-0.05 / n, 0, 1 / n, 0};
+	}();
+	const Plane floor{0, 0, 1, 0};
+	auto onFloor = [](int count) {
+		std::vector<Eigen::Vector3d> v;
+		for (int i = 0; i < count; i++) v.emplace_back(0.1 * i, 0, 0);
+		return v;
+	};
+	// 15 floor nodes (x to 1.4): 9 only the floor's (x = 0.6 ... 1.4), none
+	// only the plane's; 9 - 0 = 9 is not more than 3 sqrt(9) = 9.
+	EXPECT_FALSE(floorHoldsMoreNodes(onFloor(15), plane, floor, 0.025, 3.0));
+	// 16 (x to 1.5): 10 > 3 sqrt(10) = 9.49.
+	EXPECT_TRUE(floorHoldsMoreNodes(onFloor(16), plane, floor, 0.025, 3.0));
+	// With 2 sigma, 15 nodes are enough: 9 > 2 sqrt(9) = 6.
+	EXPECT_TRUE(floorHoldsMoreNodes(onFloor(15), plane, floor, 0.025, 2.0));
+	// The 16 floor nodes and 4 nodes on the plane only (x = 2.0 ... 2.3,
+	// z = 0.05 x, 10 to 11.5 cm above the floor): 10 - 4 = 6 is not more
+	// than 3 sqrt(14) = 11.2.
+	std::vector<Eigen::Vector3d> mixed = onFloor(16);
+	for (int i = 0; i < 4; i++) mixed.emplace_back(2.0 + 0.1 * i, 0, 0.05 * (2.0 + 0.1 * i));
+	EXPECT_FALSE(floorHoldsMoreNodes(mixed, plane, floor, 0.025, 3.0));
+	// Nodes on the plane (x = 0 ... 1.9): 14 only the plane's, none only the
+	// floor's: the plane holds more, never the floor.
+	std::vector<Eigen::Vector3d> sloped;
+	for (int i = 0; i < 20; i++) sloped.emplace_back(0.1 * i, 0, 0.005 * i);
+	EXPECT_FALSE(floorHoldsMoreNodes(sloped, plane, floor, 0.025, 3.0));
+	EXPECT_TRUE(floorHoldsMoreNodes(sloped, floor, plane, 0.025, 3.0));
+	// No node only one of them holds: no difference, no test passes.
+	EXPECT_FALSE(floorHoldsMoreNodes(onFloor(6), plane, floor, 0.025, 0.0));
+	EXPECT_FALSE(floorHoldsMoreNodes({}, plane, floor, 0.025, 3.0));
+}

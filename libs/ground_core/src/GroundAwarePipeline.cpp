@@ -176,6 +176,7 @@ const FrameResult& GroundAwarePipeline::process(
 	hint.sensor_x = frame.sensor_position.x();
 	hint.sensor_y = frame.sensor_position.y();
 	if (std::isfinite(m_result.trust_range)) hint.fill_range = evidenceRange;
+	hint.judge_against_floor = m_params.max_ground_offset > 0;
 	m_rrt.detect(m_grid, hint, m_result.detection);
 	GroundDetection& det = m_result.detection;
 	if (m_params.max_ground_offset > 0 && m_params.rrt.variant != MethodVariant::Paper && det.ok() &&

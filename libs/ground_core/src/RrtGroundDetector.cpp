@@ -232,6 +232,9 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 	// robot: else the robot may stand at the foot of a ramp whose floor
 	// shows few nodes, and the first tree (that floor) is grown again.
 	const int attempts = paper() ? 1 : m_params.seed_attempts;
+	// The trees are compared by their own ground planes; the robot's floor
+	// judges only the tree kept (see groundFromSeed).
+	m_judgeAgainstFloor = false;
 	bool fitted = false;
 	bool haveFirst = false;  // a tree whose ground plane held too few nodes
 	GroundNode firstSeed;
@@ -299,6 +302,18 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 	{
 		out.status = GroundDetection::Status::TooFewNodes;
 		return;
+	}
+	// The tree kept: its ground plane is judged against the robot's floor
+	// from here on, before fill_patches tiles patches off it.
+	m_judgeAgainstFloor = m_hint.judge_against_floor && !paper();
+	if (fitted && m_judgeAgainstFloor && !out.planes.empty())
+	{
+		m_ransacPts.clear();
+		for (const GroundNode& n : out.nodes) m_ransacPts.emplace_back(n.x, n.y, n.z);
+		if (floorHoldsMoreNodes(
+				m_ransacPts, out.planes.front(), Plane{0, 0, 1, -m_hint.floor_z}, m_params.ransac_inlier_distance,
+				kFloorTestSigmas))
+			fitted = false;
 	}
 	if (!fitted) fitPlanes(out);
 	if (m_params.variant != MethodVariant::Paper && m_params.fill_patches && !out.planes.empty())
@@ -658,7 +673,7 @@ void RrtGroundDetector::growTreePaper(const ElevationGrid& grid, const GroundNod
 }
 
 bool RrtGroundDetector::groundFromSeed(
-	const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp)
+	GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp)
 {
 	// pts are the nodes in order: pts[0] is the seed. The nodes' noise about
 	// the seed's local plane (sigma = 1.4826 x the median absolute distance
@@ -668,6 +683,7 @@ bool RrtGroundDetector::groundFromSeed(
 	// better plane brings in, until the set stops changing. Refitting to all
 	// nodes within the 2.5 cm instead let the foot of a wide ramp (its first
 	// 25 cm at 6 deg) tilt the floor toward it, which took in more of it.
+	out.ground_from_mount = false;
 	Plane pl = out.nodes.front().local;
 	m_absDist.clear();
 	for (const Eigen::Vector3d& q : pts)
@@ -696,7 +712,44 @@ bool RrtGroundDetector::groundFromSeed(
 			m_ransac.inliers.push_back(i);
 	if (m_ransac.inliers.size() < std::max<size_t>(3, rp.min_inliers)) return false;
 	m_ransac.plane = pl;
-	return true;
+	if (!m_judgeAgainstFloor) return true;
+	// A stereo camera's correlated noise can tilt the seed's window as a
+	// whole, and the refit then drift onto a plane through the near floor and
+	// another level (a step's lower floor that fill_patches tiled, a box
+	// top). Such a plane holds fewer of the nodes than the floor the mount
+	// predicts (level, at the robot's floor height); where it holds
+	// significantly fewer, that floor is the ground, as where the tree's plane
+	// passes too far from it under the robot (the pipeline's
+	// max_ground_offset), and the patches are fitted around it.
+	const Plane floor{0, 0, 1, -m_hint.floor_z};
+	if (!floorHoldsMoreNodes(pts, pl, floor, rp.inlier_distance, kFloorTestSigmas)) return true;
+	out.ground_from_mount = true;
+	out.tree_plane = pl;
+	m_ransac.inliers.clear();
+	for (size_t i = 0; i < pts.size(); i++)
+		if (std::abs(floor.signedDistance(pts[i].x(), pts[i].y(), pts[i].z())) <= rp.inlier_distance)
+			m_ransac.inliers.push_back(i);
+	m_ransac.plane = floor;
+	// (It holds at least 10 nodes more than the seed's plane: 3 sqrt(n) < n.)
+	return m_ransac.inliers.size() >= std::max<size_t>(3, rp.min_inliers);
+}
+
+bool floorHoldsMoreNodes(
+	const std::vector<Eigen::Vector3d>& nodes, const Plane& plane, const Plane& floor, double inlierDistance, double k)
+{
+	// McNemar's test on the nodes only one of the two planes holds: under
+	// "neither plane is better" each such node is the floor's with chance
+	// 1/2, so the difference of the two counts has mean 0 and standard
+	// deviation sqrt(their sum).
+	size_t floorOnly = 0, planeOnly = 0;
+	for (const Eigen::Vector3d& q : nodes)
+	{
+		const bool onFloor = std::abs(floor.signedDistance(q.x(), q.y(), q.z())) <= inlierDistance;
+		const bool onPlane = std::abs(plane.signedDistance(q.x(), q.y(), q.z())) <= inlierDistance;
+		floorOnly += onFloor && !onPlane;
+		planeOnly += onPlane && !onFloor;
+	}
+	return double(floorOnly) - double(planeOnly) > k * std::sqrt(double(floorOnly + planeOnly));
 }
 
 double RrtGroundDetector::noiseBand(double cap)
@@ -922,7 +975,9 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 			keepUnflagged();
 			continue;
 		}
-		if (!paper() && minorStd < 0.5 * m_params.expansion_distance) plane = patchFromNodesAndNormals(out, pts, C);
+		// (Not the robot's floor standing in for the ground plane: that is level.)
+		if (!paper() && minorStd < 0.5 * m_params.expansion_distance && !(k == 0 && out.ground_from_mount))
+			plane = patchFromNodesAndNormals(out, pts, C);
 		if (k == 0)
 		{
 			// The extra patches' inlier distance, from this frame's noise and

@@ -54,7 +54,12 @@ struct PipelineParams
 	 * on, or a plane fitted to a far floor by a noisy camera and tilted by
 	 * its noise, would otherwise make everything on it free. 0.10 m: beyond
 	 * what a mount within the mount check's tolerances (3 cm, 1.5 deg seen
-	 * 2 m ahead: 5 cm) and a floor's unevenness explain. 0 = off; not in the
+	 * 2 m ahead: 5 cm) and a floor's unevenness explain. The same floor
+	 * also stands in for a ground plane that holds significantly fewer of
+	 * the tree's nodes than it does (within 2.5 cm, McNemar's test at
+	 * 3 sigma: RrtGroundDetector, GroundSeedHint::judge_against_floor): a
+	 * plane the refit tilted onto a step's lower level or a box top, which
+	 * passes under the robot within 0.10 m. 0 = off (both); not in the
 	 * paper's model. [m] */
 	double max_ground_offset = 0.10;
 	/** Ramp patches of this camera's earlier frames judge this frame's voxels
@@ -82,8 +87,8 @@ struct PipelineParams
 		visit(
 			ParamInfo{
 				"max_ground_offset", 0, 100,
-				"a ground plane this far from the robot's floor under the robot is replaced by that floor [m]; 0 = "
-				"off"},
+				"a ground plane this far from the robot's floor under the robot, or holding significantly fewer "
+				"of the tree's nodes than that floor, is replaced by that floor [m]; 0 = off"},
 			p.max_ground_offset);
 		visit(
 			ParamInfo{

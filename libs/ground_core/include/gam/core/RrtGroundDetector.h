@@ -174,7 +174,9 @@ struct GroundDetection
 	double patch_inlier_distance = 0;
 	int iterations = 0;
 	/** planes[0] is the mount's floor, not the tree's plane: the tree's was
-	 * farther from the robot's floor than max_ground_offset (the pipeline). */
+	 * farther from the robot's floor than max_ground_offset under the robot
+	 * (the pipeline), or held significantly fewer of the nodes than that
+	 * floor (GroundSeedHint::judge_against_floor). */
 	bool ground_from_mount = false;
 	Plane tree_plane;  ///< the tree's plane when ground_from_mount (the mount check measures it)
 	/** planes[remembered_from..] are patches of earlier frames (PatchMemory),
@@ -213,6 +215,13 @@ struct GroundSeedHint
 	 * where the patches judge cells, not that of far floor). */
 	double fill_range = std::numeric_limits<double>::infinity();
 	double sensor_x = 0, sensor_y = 0;  ///< sensor position in the grid frame
+	/** The floor at floor_z (level) is what the mount predicts: where the
+	 * ground plane grown from the seed holds significantly fewer of the
+	 * nodes than that floor does (floorHoldsMoreNodes at kFloorTestSigmas),
+	 * that floor is the ground plane and the patches are fitted around it
+	 * (GroundDetection::ground_from_mount; the pipeline sets it with
+	 * max_ground_offset > 0). */
+	bool judge_against_floor = false;
 
 	bool withinFillRange(double px, double py) const
 	{
@@ -220,6 +229,18 @@ struct GroundSeedHint
 		return dx * dx + dy * dy <= fill_range * fill_range;
 	}
 };
+
+/** How many standard deviations floorHoldsMoreNodes() asks of the
+ * difference (the 3 sigma of the rest of the method). */
+constexpr double kFloorTestSigmas = 3.0;
+
+/** Whether `floor` holds significantly more of `nodes` than `plane` does,
+ * each holding the nodes within `inlierDistance` of it: of the nodes only
+ * one of them holds, the floor's count exceeds the plane's by more than k
+ * standard deviations of that difference under "neither is better"
+ * (McNemar's test: k sqrt(floor's + plane's)). */
+bool floorHoldsMoreNodes(
+	const std::vector<Eigen::Vector3d>& nodes, const Plane& plane, const Plane& floor, double inlierDistance, double k);
 
 /** Whether an extra ground patch (plane `patch`, on node p) and an accepted
  * plane Q (on node q, at most a tree step from p) meet between p and q rather
@@ -340,9 +361,12 @@ class RrtGroundDetector
 	std::vector<std::pair<float, uint32_t>> m_candidates;  ///< paper fallback: (distance^2, node)
 	/** The planes of out.nodes, from scratch (earlier planes and node labels dropped). */
 	void fitPlanes(GroundDetection& out);
-	/** The ground plane grown from the seed's local plane (see fitPlanes);
-	 * false if it has fewer than rp.min_inliers nodes. Into m_ransac. */
-	bool groundFromSeed(const GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
+	/** The ground plane grown from the seed's local plane (see fitPlanes),
+	 * or the hint's floor where that holds significantly more of the nodes
+	 * (GroundSeedHint::judge_against_floor; then ground_from_mount, and
+	 * tree_plane the seed's plane); false if it has fewer than
+	 * rp.min_inliers nodes. Into m_ransac. */
+	bool groundFromSeed(GroundDetection& out, const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
 	/** Keeps, of m_ransac's inliers, the largest group linked by steps of at
 	 * most d_n, and refits its plane (see fitPlanes). */
 	void keepLargestCluster(const std::vector<Eigen::Vector3d>& pts, const RansacParams& rp);
@@ -379,6 +403,9 @@ class RrtGroundDetector
 	std::vector<uint32_t> m_fillQueue;
 	double m_resolution = 0.05;  ///< of the grid in detect() [m]
 	GroundSeedHint m_hint;       ///< of the frame in detect()
+	/** groundFromSeed judges the ground plane against the hint's floor: the
+	 * tree kept, not the trees compared by rule R10 (detect()). */
+	bool m_judgeAgainstFloor = false;
 	std::vector<double> m_absDist;
 	void reserveScratch(const GridGeometry& g);
 	size_t maxTreeNodes(const GridGeometry& g) const;
