@@ -306,12 +306,14 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 	// The tree kept: its ground plane is judged against the robot's floor
 	// from here on, before fill_patches tiles patches off it.
 	m_judgeAgainstFloor = m_hint.judge_against_floor && !paper();
-	if (fitted && m_judgeAgainstFloor && !out.planes.empty())
+	// (The tree's planes, if fitted in the loop, are fitted again only where
+	// the floor would replace the seed's plane: the test groundFromSeed runs.)
+	if (fitted && m_judgeAgainstFloor && m_seedPlaneFitted)
 	{
 		m_ransacPts.clear();
 		for (const GroundNode& n : out.nodes) m_ransacPts.emplace_back(n.x, n.y, n.z);
 		if (floorHoldsMoreNodes(
-				m_ransacPts, out.planes.front(), Plane{0, 0, 1, -m_hint.floor_z}, m_params.ransac_inlier_distance,
+				m_ransacPts, m_seedPlane, Plane{0, 0, 1, -m_hint.floor_z}, m_params.ransac_inlier_distance,
 				kFloorTestSigmas))
 			fitted = false;
 	}
@@ -684,6 +686,7 @@ bool RrtGroundDetector::groundFromSeed(
 	// nodes within the 2.5 cm instead let the foot of a wide ramp (its first
 	// 25 cm at 6 deg) tilt the floor toward it, which took in more of it.
 	out.ground_from_mount = false;
+	m_seedPlaneFitted = false;
 	Plane pl = out.nodes.front().local;
 	m_absDist.clear();
 	for (const Eigen::Vector3d& q : pts)
@@ -712,6 +715,8 @@ bool RrtGroundDetector::groundFromSeed(
 			m_ransac.inliers.push_back(i);
 	if (m_ransac.inliers.size() < std::max<size_t>(3, rp.min_inliers)) return false;
 	m_ransac.plane = pl;
+	m_seedPlane = pl;
+	m_seedPlaneFitted = true;
 	if (!m_judgeAgainstFloor) return true;
 	// A stereo camera's correlated noise can tilt the seed's window as a
 	// whole, and the refit then drift onto a plane through the near floor and
@@ -866,6 +871,8 @@ void RrtGroundDetector::fitPlanes(GroundDetection& out)
 	// fit of these nodes (another tree, or before fill_patches) are dropped.
 	out.planes.clear();
 	out.plane_support.clear();
+	out.ground_from_mount = false;
+	m_seedPlaneFitted = false;
 	for (GroundNode& n : out.nodes) n.plane_id = -1;
 	std::vector<size_t>& remaining = m_remaining;
 	remaining.resize(out.nodes.size());

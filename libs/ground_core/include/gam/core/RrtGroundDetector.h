@@ -406,6 +406,10 @@ class RrtGroundDetector
 	/** groundFromSeed judges the ground plane against the hint's floor: the
 	 * tree kept, not the trees compared by rule R10 (detect()). */
 	bool m_judgeAgainstFloor = false;
+	/** The plane groundFromSeed grew from the seed in the last fitPlanes(),
+	 * before any test against the floor (m_seedPlaneFitted: it did). */
+	Plane m_seedPlane;
+	bool m_seedPlaneFitted = false;
 	std::vector<double> m_absDist;
 	void reserveScratch(const GridGeometry& g);
 	size_t maxTreeNodes(const GridGeometry& g) const;
