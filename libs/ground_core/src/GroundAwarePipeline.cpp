@@ -184,7 +184,7 @@ const FrameResult& GroundAwarePipeline::process(
 	{
 		// Not the floor the robot stands on: judge the frame against that floor.
 		det.tree_plane = det.planes[0];
-		det.planes[0] = Plane{0, 0, 1, -robot.z()};
+		det.planes[0] = hint.floorPlane();
 		det.ground_from_mount = true;
 	}
 	// The ramp patches of this camera's earlier frames (in the map frame),

@@ -313,8 +313,7 @@ void RrtGroundDetector::detect(const ElevationGrid& grid, const GroundSeedHint& 
 		m_ransacPts.clear();
 		for (const GroundNode& n : out.nodes) m_ransacPts.emplace_back(n.x, n.y, n.z);
 		if (floorHoldsMoreNodes(
-				m_ransacPts, m_seedPlane, Plane{0, 0, 1, -m_hint.floor_z}, m_params.ransac_inlier_distance,
-				kFloorTestSigmas))
+				m_ransacPts, m_seedPlane, m_hint.floorPlane(), m_params.ransac_inlier_distance, kFloorTestSigmas))
 			fitted = false;
 	}
 	if (!fitted) fitPlanes(out);
@@ -709,12 +708,15 @@ bool RrtGroundDetector::groundFromSeed(
 		pl = *refined;
 	}
 	// Its nodes: all within the inlier distance, as for any plane.
-	m_ransac.inliers.clear();
-	for (size_t i = 0; i < pts.size(); i++)
-		if (std::abs(pl.signedDistance(pts[i].x(), pts[i].y(), pts[i].z())) <= rp.inlier_distance)
-			m_ransac.inliers.push_back(i);
-	if (m_ransac.inliers.size() < std::max<size_t>(3, rp.min_inliers)) return false;
-	m_ransac.plane = pl;
+	const auto takeNodesOf = [&](const Plane& plane) {
+		m_ransac.plane = plane;
+		m_ransac.inliers.clear();
+		for (size_t i = 0; i < pts.size(); i++)
+			if (std::abs(plane.signedDistance(pts[i].x(), pts[i].y(), pts[i].z())) <= rp.inlier_distance)
+				m_ransac.inliers.push_back(i);
+		return m_ransac.inliers.size() >= std::max<size_t>(3, rp.min_inliers);
+	};
+	if (!takeNodesOf(pl)) return false;
 	m_seedPlane = pl;
 	m_seedPlaneFitted = true;
 	if (!m_judgeAgainstFloor) return true;
@@ -726,17 +728,11 @@ bool RrtGroundDetector::groundFromSeed(
 	// significantly fewer, that floor is the ground, as where the tree's plane
 	// passes too far from it under the robot (the pipeline's
 	// max_ground_offset), and the patches are fitted around it.
-	const Plane floor{0, 0, 1, -m_hint.floor_z};
-	if (!floorHoldsMoreNodes(pts, pl, floor, rp.inlier_distance, kFloorTestSigmas)) return true;
+	if (!floorHoldsMoreNodes(pts, pl, m_hint.floorPlane(), rp.inlier_distance, kFloorTestSigmas)) return true;
 	out.ground_from_mount = true;
 	out.tree_plane = pl;
-	m_ransac.inliers.clear();
-	for (size_t i = 0; i < pts.size(); i++)
-		if (std::abs(floor.signedDistance(pts[i].x(), pts[i].y(), pts[i].z())) <= rp.inlier_distance)
-			m_ransac.inliers.push_back(i);
-	m_ransac.plane = floor;
 	// (It holds at least 10 nodes more than the seed's plane: 3 sqrt(n) < n.)
-	return m_ransac.inliers.size() >= std::max<size_t>(3, rp.min_inliers);
+	return takeNodesOf(m_hint.floorPlane());
 }
 
 bool floorHoldsMoreNodes(

@@ -223,6 +223,8 @@ struct GroundSeedHint
 	 * max_ground_offset > 0). */
 	bool judge_against_floor = false;
 
+	/** The floor the mount predicts: level, at floor_z. */
+	Plane floorPlane() const { return Plane{0, 0, 1, -floor_z}; }
 	bool withinFillRange(double px, double py) const
 	{
 		const double dx = px - sensor_x, dy = py - sensor_y;
