@@ -429,15 +429,8 @@ std::string runNavBench(const NavBenchOptions& o, std::ostream& progress)
 		if (o.writeScenes)
 		{
 			fs::create_directories(o.outDir + "/scenes");
-			const std::string file = o.outDir + "/scenes/seed_" + std::to_string(s) + ".scene";
-			if (o.writeScenesPath > 0)
-			{
-				std::ofstream f(file);
-				f << gam::sim::withApproachPath(scenes.back(), o.writeScenesPath);
-				if (!f) throw std::runtime_error("cannot write " + file);
-			}
-			else
-				gam::sim::writeGeneratedScene(scenes.back(), file);
+			gam::sim::writeGeneratedScene(
+				scenes.back(), o.outDir + "/scenes/seed_" + std::to_string(s) + ".scene", o.writeScenesPath);
 		}
 		if (s == o.lastSeed) break;  // lastSeed may be UINT_MAX
 	}

@@ -582,10 +582,10 @@ std::string withApproachPath(const GeneratedScene& g, double metres, double spac
 	return g.text.substr(0, at + 1) + line + g.text.substr(end);
 }
 
-void writeGeneratedScene(const GeneratedScene& g, const std::string& file)
+void writeGeneratedScene(const GeneratedScene& g, const std::string& file, double approachMetres)
 {
 	std::ofstream f(file);
-	f << g.text;
+	f << (approachMetres > 0 ? withApproachPath(g, approachMetres) : g.text);
 	if (!f) throw std::runtime_error("cannot write " + file);
 }
 

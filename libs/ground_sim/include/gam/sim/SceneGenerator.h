@@ -82,8 +82,10 @@ struct GeneratedScene
 GeneratedScene generateScene(unsigned seed, const GeneratorOptions& opts = {});
 
 /** Writes g.text (a scene file gam-simulate and the nav example read; the
- * start, goal and hazards are in its header comments). Throws on failure. */
-void writeGeneratedScene(const GeneratedScene& g, const std::string& file);
+ * start, goal and hazards are in its header comments), with
+ * approachMetres > 0 as withApproachPath(g, approachMetres). Throws on
+ * failure. */
+void writeGeneratedScene(const GeneratedScene& g, const std::string& file, double approachMetres = 0);
 
 /** g.text with its path line (the start pose alone: one depth frame) replaced
  * by a drive of `metres` from the start straight toward the goal, facing it,
