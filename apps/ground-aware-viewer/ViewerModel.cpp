@@ -330,8 +330,8 @@ std::string ViewerModel::statusText() const
 	{
 		o << "ground: " << d.detection.describe() << "\n";
 		o << "voxels: ground " << d.ism.ground << ", obstacle " << d.ism.obstacle << ", drop " << d.ism.drop
-		  << ", overhead " << d.ism.overhead << ", out of range " << d.ism.out_of_range << ", drop-ray cells "
-		  << d.ism.drop_ray_cells << "; points " << d.points << "\n";
+		  << ", out of range " << d.ism.out_of_range << ", drop-ray cells " << d.ism.drop_ray_cells << "; points "
+		  << d.points << "\n";
 		if (d.camera != gam::CameraModel::Custom || std::isfinite(d.trust_range))
 		{
 			o << "camera: " << gam::kCameraModelNames[int(d.camera)];

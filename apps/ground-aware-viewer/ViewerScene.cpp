@@ -150,7 +150,6 @@ TColor classColour(gam::VoxelClass c)
 		case gam::VoxelClass::Ground: return {40, 190, 60};
 		case gam::VoxelClass::Obstacle: return {230, 40, 30};
 		case gam::VoxelClass::Drop: return {200, 40, 220};
-		case gam::VoxelClass::Overhead: return {150, 150, 150};
 		case gam::VoxelClass::OutOfRange: return {90, 90, 90};
 		default: return {70, 120, 230};
 	}

@@ -199,8 +199,9 @@ TEST(InverseSensorModel, ClassifyAgainstAPlane)
 	EXPECT_EQ(ism.classify(cellOf({-0.06f}), 1, 1, kFloor, band, d), VoxelClass::Drop);
 	// Top on the floor, bottom 20 cm below: edge of a hole.
 	EXPECT_EQ(ism.classify(cellOf({-0.2f, 0.01f}), 1, 1, kFloor, band, d), VoxelClass::Drop);
-	// Entirely above the robot: ignored; reaching down below robot_height: obstacle.
-	EXPECT_EQ(ism.classify(cellOf({1.9f, 2.2f}), 1, 1, kFloor, band, d), VoxelClass::Overhead);
+	// Above the ground: an obstacle, however high (the pipeline does not
+	// project what lies above robot_height; the ISM judges what it is given).
+	EXPECT_EQ(ism.classify(cellOf({1.9f, 2.2f}), 1, 1, kFloor, band, d), VoxelClass::Obstacle);
 	EXPECT_EQ(ism.classify(cellOf({1.0f, 2.0f}), 1, 1, kFloor, band, d), VoxelClass::Obstacle);
 	// A wall through the plane (from below it to above it) is an obstacle.
 	EXPECT_EQ(ism.classify(cellOf({-0.3f, 1.0f}), 1, 1, kFloor, band, d), VoxelClass::Obstacle);
@@ -218,11 +219,6 @@ TEST(InverseSensorModel, ClassifyAgainstAPlane)
 	EXPECT_NEAR(d, c * 0.1, 1e-6);
 	// Flat-floor height 0 at x = 1 is 17 cm below that plane.
 	EXPECT_EQ(ism.classify(cellOf({0.0f}), 1, 0, tilted, band, d), VoxelClass::Drop);
-
-	IsmParams p;
-	p.robot_height = 0.5;
-	ism.setParams(p);
-	EXPECT_EQ(ism.classify(cellOf({1.0f, 1.2f}), 1, 1, kFloor, band, d), VoxelClass::Overhead);
 }
 
 TEST(InverseSensorModel, ClassifyByTheMeanOfNSamples)
@@ -428,7 +424,7 @@ TEST(InverseSensorModel, DeepSamplesBeyondTheFloorNoiseMakeADrop)
 	// 1 mm above -T the samples do not count.
 	const ElevationGrid shallow = deepCellFrame(27, {above, above, above}, b);
 	EXPECT_EQ(classOf(shallow, &b), VoxelClass::Ground);
-	// Two deep samples are fewer than drop_ray_min_points = 3 (a spike pair).
+	// Two deep samples are fewer than min_obstacle_points = 3 (a spike pair).
 	const ElevationGrid two = deepCellFrame(28, {below, below}, b);
 	EXPECT_EQ(classOf(two, &b), VoxelClass::Ground);
 }
@@ -649,10 +645,9 @@ TEST(InverseSensorModel, ASpikeAmongFloorSamplesIsNoObstacle)
 	// rule: its top (bottom) is far beyond the band (0.0407, see
 	// handDeepThreshold), so the cell is an obstacle (drop) by z_max (z_min).
 	// With the frame's samples an obstacle or a drop counts only if
-	// min_obstacle_points = 3 of them lie beyond the band; a drop ray needs
-	// drop_ray_min_points = 3.
+	// min_obstacle_points = 3 of them lie beyond the band (and a drop casts
+	// its ray with as many).
 	ASSERT_EQ(deepParams().min_obstacle_points, 3);
-	ASSERT_EQ(deepParams().drop_ray_min_points, 3);
 	InverseSensorModel ism(deepParams());
 	IsmStats st;
 	BinnedPoints b;
@@ -801,7 +796,7 @@ ElevationGrid sceneFrame()
 }
 }  // namespace
 
-TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
+TEST(InverseSensorModel, EndToEndFloorBoxHoleBeamRange)
 {
 	const ElevationGrid frame = sceneFrame();
 	const GridGeometry& g = frame.geometry();
@@ -812,7 +807,7 @@ TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 4.0, st);  // max range 4 m
 	EXPECT_TRUE(st.applied);
 
-	const double pBox = handObstacleP(5, 0.4, 0.05);   // rho 5000: 0.651016
+	const double pBox = handObstacleP(5, 0.4, 0.05);   // rho 5000: 0.651016 (the beam's too)
 	const double pHole = handObstacleP(1, 0.0, 0.05);  // rho 8000: 0.792423
 	const double pShelf = handObstacleP(16, 1.5, 0.05);
 	EXPECT_NEAR(pBox, 0.5 + 0.4 / (1 + std::exp(0.5)), 1e-12);
@@ -848,9 +843,12 @@ TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
 			}
 			else if (isBeam(x, y))
 			{
+				// 1.9-2.3 m up, 5 samples: an obstacle to the ISM, which judges
+				// the 2.5D map it is given (the pipeline does not project it:
+				// GroundAwareGrid.OverheadBeamDoesNotBlockButATableDoes).
 				nBeam++;
-				EXPECT_EQ(k, VoxelClass::Overhead);
-				EXPECT_EQ(e, 0.5f);
+				EXPECT_EQ(k, VoxelClass::Obstacle);
+				EXPECT_NEAR(e, pBox, 1e-6);
 			}
 			else if (isShelf(x, y))
 			{
@@ -877,20 +875,19 @@ TEST(InverseSensorModel, EndToEndFloorBoxHoleOverheadRange)
 	ASSERT_EQ(nShelf, 4u);
 	ASSERT_EQ(nFar, 4u);
 	EXPECT_EQ(st.ground, nFloor);
-	EXPECT_EQ(st.obstacle, nBox + nShelf);
+	EXPECT_EQ(st.obstacle, nBox + nBeam + nShelf);
 	EXPECT_EQ(st.drop, nHole);
-	EXPECT_EQ(st.overhead, nBeam);
 	EXPECT_EQ(st.out_of_range, nFar);
 	// The hole's rays crossed the plane over observed floor: nothing to mark.
 	EXPECT_EQ(st.drop_ray_cells, 0u);
-	EXPECT_EQ(ism.evidenceCells().size(), nFloor + nBox + nHole + nShelf);
+	EXPECT_EQ(ism.evidenceCells().size(), nFloor + nBox + nBeam + nHole + nShelf);
 	checkEvidenceBookkeeping(ism);
 
 	// With a 5 m max range the far box counts.
 	ism.setParams(IsmParams{});
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
 	EXPECT_EQ(st.out_of_range, 0u);
-	EXPECT_EQ(st.obstacle, nBox + nShelf + nFar);
+	EXPECT_EQ(st.obstacle, nBox + nBeam + nShelf + nFar);
 	EXPECT_GT(ism.evidence()[g.index(g.ix(4.25), g.iy(0.05))], 0.5f);
 	checkEvidenceBookkeeping(ism);
 }
@@ -925,7 +922,7 @@ TEST(InverseSensorModel, NoPlaneNeverInventsObstacles)
 		ism.compute(frame, handDetection(kFloor, s), {0, 0, 1}, 5.0, st);
 		EXPECT_FALSE(st.applied);
 		EXPECT_TRUE(ism.evidenceCells().empty()) << GroundDetection::statusName(s);
-		EXPECT_EQ(st.obstacle + st.ground + st.drop + st.overhead + st.out_of_range, 0u);
+		EXPECT_EQ(st.obstacle + st.ground + st.drop + st.out_of_range, 0u);
 		for (float e : ism.evidence()) ASSERT_EQ(e, 0.5f);
 		for (VoxelClass k : ism.classes()) ASSERT_EQ(k, VoxelClass::None);
 	}
@@ -982,14 +979,15 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 	const ElevationGrid frame = stepFrame();
 	const GridGeometry& g = frame.geometry();
 	IsmParams prm;
-	prm.min_obstacle_points = 1;  // the lower floor has one sample per cell
 	IsmStats st;
-	// By default a drop voxel needs 3 samples to cast a ray: these have one.
+	// By default a drop voxel needs 3 samples to count, and so to cast a ray:
+	// these have one.
 	InverseSensorModel strict(prm);
 	strict.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);
-	EXPECT_EQ(st.drop, 18u * 20u);
+	EXPECT_EQ(st.drop, 0u);
+	EXPECT_EQ(st.sparse, 18u * 20u);
 	EXPECT_EQ(st.drop_ray_cells, 0u);
-	prm.drop_ray_min_points = 1;
+	prm.min_obstacle_points = 1;  // the lower floor has one sample per cell
 	InverseSensorModel ism(prm);
 	// Sensor 1 m above the plane at the origin: the ray to a voxel at (x, y,
 	// -0.3) crosses z = 0 at 1/1.3 of the way, e.g. x = 2.625 -> 2.019 and
@@ -1046,7 +1044,6 @@ TEST(InverseSensorModel, DropRaysMarkCellsBetweenCrossingAndVoxel)
 
 	IsmParams p;
 	p.min_obstacle_points = 1;
-	p.drop_ray_min_points = 1;
 	// Disabled: the gap stays unknown, the drop voxels still count.
 	p.drop_rays = false;
 	ism.setParams(p);
@@ -1109,13 +1106,13 @@ TEST(InverseSensorModel, DropRayIsNotCastThroughAnObstacle)
 	for (double x = 2.825; x < 3.1; x += 0.05) EXPECT_EQ(ism.evidence()[g.index(g.ix(x), g.iy(0.025))], 0.5f) << x;
 }
 
-TEST(InverseSensorModel, DropRayMinPoints)
+TEST(InverseSensorModel, ADropCastsItsRayWithTheCountItCountsWith)
 {
-	// Default drop_ray_min_points = 3: lower cells with 3 samples cast rays,
-	// with 2 they are still drops (min_obstacle_points = 2 here) but cast none.
+	// Default min_obstacle_points = 3: lower cells with 3 samples are drops
+	// and cast rays; with 2 they are neither (a spike pair paints nothing);
+	// with min_obstacle_points = 2 those are drops and cast rays.
 	IsmParams p;
-	ASSERT_EQ(p.drop_ray_min_points, 3);
-	p.min_obstacle_points = 2;
+	ASSERT_EQ(p.min_obstacle_points, 3);
 	InverseSensorModel ism(p);
 	IsmStats st;
 	const ElevationGrid three = stepFrame(3);
@@ -1129,9 +1126,19 @@ TEST(InverseSensorModel, DropRayMinPoints)
 
 	const ElevationGrid two = stepFrame(2);
 	ism.compute(two, handDetection(kFloor), {0, 0, 1}, 5.0, st);
-	EXPECT_EQ(st.drop, 18u * 20u);
+	EXPECT_EQ(st.drop, 0u);
+	EXPECT_EQ(st.sparse, 18u * 20u);
 	EXPECT_EQ(st.drop_ray_cells, 0u);
 	EXPECT_EQ(ism.evidence()[g.index(g.ix(2.4), g.iy(0.0))], 0.5f);
+
+	p.min_obstacle_points = 2;
+	ism.setParams(p);
+	ism.compute(two, handDetection(kFloor), {0, 0, 1}, 5.0, st);
+	EXPECT_EQ(st.drop, 18u * 20u);
+	EXPECT_GT(st.drop_ray_cells, 50u);
+	// rho = 2 / 0.05^3 = 16000 -> P_rho = 1/(1+e^-(K_n rho - d_min)) = 1/(1+e^-5).
+	const double p2 = 0.5 + 0.4 / (1 + std::exp(-5.0));
+	EXPECT_NEAR(ism.evidence()[g.index(g.ix(2.4), g.iy(0.0))], p2, 1e-6);
 }
 
 TEST(InverseSensorModel, NeutralEvidenceIsNeverListed)
@@ -1143,8 +1150,7 @@ TEST(InverseSensorModel, NeutralEvidenceIsNeverListed)
 	IsmParams p;
 	p.K_g = 0;
 	p.K_m = 0;
-	p.drop_ray_min_points = 1;  // the lower cells have one sample: let them cast rays
-	p.min_obstacle_points = 1;
+	p.min_obstacle_points = 1;  // the lower cells have one sample: let them count and cast rays
 	InverseSensorModel ism(p);
 	IsmStats st;
 	ism.compute(frame, handDetection(kFloor), {0, 0, 1}, 5.0, st);

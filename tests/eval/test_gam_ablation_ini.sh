@@ -34,7 +34,7 @@ opts_of no_scan_rule | grep -qx "scan_keeps_3d_obstacles=false" || fail "no_scan
 opts_of no_near_edge_scan | grep -qx "sparse_scan_near_edge=false" || fail "no_near_edge_scan"
 opts_of ground_aware | grep -qx "sparse_scan_near_edge=true" || fail "ground_aware keeps the near-edge scans"
 opts_of ground_aware | grep -qx "scan_keeps_3d_obstacles=true" || fail "ground_aware keeps the base's scan rule"
-opts_of no_min_points | grep -qx "drop_ray_min_points=1" || fail "no_min_points: drop_ray_min_points=1"
+opts_of no_min_points | grep -qx "min_obstacle_points=1" || fail "no_min_points: min_obstacle_points=1"
 opts_of no_range_of_trust | grep -qx "range_of_trust=false" || fail "no_range_of_trust"
 opts_of no_range_smear | grep -qx "range_smear=false" || fail "no_range_smear"
 opts_of ground_aware | grep -qx "range_smear=true" || fail "ground_aware keeps range_smear"

@@ -800,10 +800,13 @@ TEST(MapperCli, RetiredKeysAreIgnoredWithAWarning)
 		"[map_groundAwareGrid_00_groundOpts]\n"
 		"max_drop_ray_length=2.0\n"
 		"missing_floor_min_range=0.5\n"
-		"max_fit_rms=0.025\n",
+		"max_fit_rms=0.025\n"
+		"min_drop_points=2\n"
+		"drop_ray_min_points=3\n",
 		out);
 	ASSERT_EQ(r.rc, 0) << r.err;
-	for (const char* key : {"max_drop_ray_length", "missing_floor_min_range", "max_fit_rms"})
+	for (const char* key :
+		 {"max_drop_ray_length", "missing_floor_min_range", "max_fit_rms", "min_drop_points", "drop_ray_min_points"})
 		EXPECT_NE(
 			r.err.find(
 				std::string("warning: [map_groundAwareGrid_00_groundOpts] key '") + key +

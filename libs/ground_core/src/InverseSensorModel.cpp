@@ -192,7 +192,6 @@ VoxelClass InverseSensorModel::classify(
 	const double dBot = pl.signedDistance(x, y, c.z_min);
 	dMean = pl.signedDistance(x, y, c.mean());
 	const double th = band;
-	if (dBot > m_params.robot_height) return VoxelClass::Overhead;
 	if (dTop < -th) return VoxelClass::Drop;
 	if (dTop > th) return VoxelClass::Obstacle;
 	// Top within the band; a bottom far below it is the edge of a hole.
@@ -446,7 +445,6 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 			m_tailCount[c]++;
 	}
 	const double alpha = ism::normalTail(m_params.noise_sigmas);
-	const uint32_t minRay = uint32_t(std::max(1, m_params.drop_ray_min_points));
 	const bool smear = smearTest();
 	// The counts stay until clearTailCandidates(): range_smear reads them.
 	for (const TailCandidate& d : m_tailCandidates)
@@ -457,7 +455,7 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 		{
 			// A ground cell the count makes a drop (deep) or an obstacle (raised).
 			const bool drop = d.kind == TailKind::Deep;
-			if (k < (drop ? minRay : minPoints()) || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
+			if (k < minPoints() || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
 			// Its ground evidence stays if range_smear takes this back.
 			m_class[d.cell] = drop ? VoxelClass::Drop : VoxelClass::Obstacle;
 			hold(Held{d.cell, k, drop, drop && m_params.drop_rays, true}, smear, frame, stats);
@@ -465,14 +463,15 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 		}
 		// An obstacle or a drop judged by its extreme sample: it takes as many
 		// samples beyond the band as any other (a lone spike among floor
-		// samples is no obstacle, and casts no ray).
+		// samples is no obstacle, and casts no ray: a drop that counts casts
+		// its ray).
 		const bool drop = d.kind == TailKind::Below;
 		if (k < minPoints())
 		{
 			stats.sparse++;
 			continue;
 		}
-		hold(Held{d.cell, k, drop, drop && m_params.drop_rays && k >= minRay, false}, smear, frame, stats);
+		hold(Held{d.cell, k, drop, drop && m_params.drop_rays, false}, smear, frame, stats);
 	}
 }
 
@@ -611,7 +610,7 @@ void InverseSensorModel::compute(
 					deferred = true;
 				}
 			}
-			if (deepTest && cls == VoxelClass::Ground && c.count >= uint32_t(std::max(1, m_params.drop_ray_min_points)))
+			if (deepTest && cls == VoxelClass::Ground && c.count >= minPoints())
 			{
 				// Floor sample scatter around the plane: one sample's noise and
 				// the cells' offsets (d_pth as 3 sigma where not measured).
@@ -670,15 +669,9 @@ void InverseSensorModel::compute(
 				}
 				if (deferred) break;
 				const bool drop = cls == VoxelClass::Drop;
-				hold(
-					Held{
-						idx, c.count, drop,
-						drop && m_params.drop_rays && c.count >= uint32_t(std::max(1, m_params.drop_ray_min_points)),
-						false},
-					smear, frame, stats);
+				hold(Held{idx, c.count, drop, drop && m_params.drop_rays, false}, smear, frame, stats);
 				break;
 			}
-			case VoxelClass::Overhead: stats.overhead++; break;
 			case VoxelClass::OutOfRange: stats.out_of_range++; break;
 			case VoxelClass::None: break;
 		}
@@ -772,7 +765,7 @@ void InverseSensorModel::compute(
 			if (q < 0 || q == lastCell || uint32_t(q) == idx) continue;
 			lastCell = q;
 			const VoxelClass qc = m_class[size_t(q)];
-			if (qc == VoxelClass::Ground || qc == VoxelClass::Overhead) continue;
+			if (qc == VoxelClass::Ground) continue;
 			if (m_evidence[size_t(q)] <= 0.5f) stats.drop_ray_cells++;
 			put(uint32_t(q), p);
 		}

@@ -76,6 +76,7 @@ const char* retiredKeyReason(const std::string& suffix, const std::string& key)
 		{"_groundOpts", "missing_floor_min_range",
 		 "a missing-floor region needs seen floor nearer along its rays, which covers it"},
 		{"_groundOpts", "min_drop_points", "a drop takes min_obstacle_points, as an obstacle does"},
+		{"_groundOpts", "drop_ray_min_points", "a drop that counts (min_obstacle_points) casts its drop ray"},
 	};
 	for (const Retired& r : kRetired)
 		if (suffix == r.suffix && gam::iequals(key, r.key)) return r.why;

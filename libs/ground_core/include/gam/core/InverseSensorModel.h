@@ -81,7 +81,7 @@ struct IsmParams
 	 * noise_sigmas where unmeasured); a cell whose k such samples (of the N
 	 * the 3-sigma rule kept) have P(Binomial(N, p0) >= k) < Phi(-noise_sigmas),
 	 * the false-alarm rate of the band itself, is a drop, if k >=
-	 * drop_ray_min_points (a depth spike is not a hole). Off: the cell's
+	 * min_obstacle_points (a depth spike is not a hole). Off: the cell's
 	 * z_min and mean only. */
 	bool deep_sample_test = true;
 	/** The deep-sample test's count above the plane, for a camera whose
@@ -143,22 +143,27 @@ struct IsmParams
 	 * 0.62 -> 0.35 %, see doc/benchmark.md). A drop takes this count too:
 	 * seen from afar, the far side of a ramp is such a drop (a drop below the
 	 * ground plane took 2 until 2026-11-27; the steps and holes it was for
-	 * are marked as far with 3, doc/rules.md I12). A voxel judged by its top
+	 * are marked as far with 3, doc/rules.md I12), and a drop that counts
+	 * casts its drop ray (a ray took its own count, drop_ray_min_points, also
+	 * 3, until 2026-11-29, doc/rules.md I16). A voxel judged by its top
 	 * (bottom) sample while others lie in the band needs this many samples
 	 * beyond the band (given the frame's samples): a spike among floor
 	 * samples is no obstacle. */
 	int min_obstacle_points = 3;
-	/** Voxels whose bottom is more than this above the ground do not block
-	 * (ceiling, door frames, beams above the robot). [m] */
+	/** Points more than this above the robot's floor (robot frame) do not
+	 * block (ceiling, door frames, beams above the robot): the pipeline does
+	 * not project them (GroundAwarePipeline's projection filter). The ISM
+	 * itself takes the 2.5D map it is given (it dropped voxels this far above
+	 * the ground plane too until 2026-11-29, which changed no map after the
+	 * projection's crop, doc/rules.md I10). [m] */
 	double robot_height = 1.8;
 	/** Below-ground voxels also mark the cells between the point where their
-	 * ray crossed the ground plane and the voxel: no floor was there. */
-	bool drop_rays = true;
-	/** A drop voxel casts its ray only with at least this many samples (below
-	 * the band, for a voxel judged by its bottom sample): one stray return (a
+	 * ray crossed the ground plane and the voxel: no floor was there. A drop
+	 * voxel casts its ray when it counts (min_obstacle_points samples, below
+	 * the band for a voxel judged by its bottom sample): one stray return (a
 	 * depth spike, a reflection metres below the floor) must not paint a line
 	 * of obstacles across the floor. */
-	int drop_ray_min_points = 3;
+	bool drop_rays = true;
 	/** Use the tree's extra ground patches (ramps) near their nodes. */
 	bool local_planes = true;
 	/** How far from its nodes a ground patch applies. [m] */
@@ -227,11 +232,10 @@ struct IsmParams
 			ParamInfo{"floor_noise_min_cells", 1, 1000000, "floor cells a range bin needs to be measured"},
 			p.floor_noise_min_cells);
 		visit(ParamInfo{"floor_noise_bin", 0.05, 10, "range bin of the measured floor noise [m]"}, p.floor_noise_bin);
-		visit(ParamInfo{"robot_height", 1e-3, 100, "voxels entirely above this do not block [m]"}, p.robot_height);
-		visit(ParamInfo{"drop_rays", 0, 1, "mark cells where rays went below the ground"}, p.drop_rays);
 		visit(
-			ParamInfo{"drop_ray_min_points", 1, 1000000, "samples a drop voxel needs to cast its ray"},
-			p.drop_ray_min_points);
+			ParamInfo{"robot_height", 1e-3, 100, "points above this (robot frame) are not projected [m]"},
+			p.robot_height);
+		visit(ParamInfo{"drop_rays", 0, 1, "mark cells where rays went below the ground"}, p.drop_rays);
 		visit(ParamInfo{"local_planes", 0, 1, "use ramp patches near their nodes"}, p.local_planes);
 		visit(
 			ParamInfo{"plane_support_radius", 0, 100, "reach of a ramp patch around its nodes [m]"},
@@ -342,13 +346,12 @@ enum class VoxelClass : uint8_t
 	Ground,
 	Obstacle,   ///< sticks out above the ground
 	Drop,       ///< entirely below the ground: hole, outlet, downward step
-	Overhead,   ///< above robot_height: ignored
 	OutOfRange  ///< beyond max_range: ignored
 };
 
 struct IsmStats
 {
-	size_t ground = 0, obstacle = 0, drop = 0, overhead = 0, out_of_range = 0;
+	size_t ground = 0, obstacle = 0, drop = 0, out_of_range = 0;
 	size_t sparse = 0;  ///< obstacle/drop voxels below min_obstacle_points: ignored
 	size_t drop_ray_cells = 0;
 	size_t drop_rays_unsupported = 0;  ///< drop rays not cast: an obstacle stood between the sensor and the crossing
@@ -492,7 +495,7 @@ class InverseSensorModel
 	/** Counts each candidate cell's kept samples beyond its threshold, then
 	 * decides it: deep_sample_test (a floor cell becomes a drop), or an
 	 * obstacle / drop judged by its extreme sample (min_obstacle_points of
-	 * them beyond the band give evidence, drop_ray_min_points cast a ray);
+	 * them beyond the band give evidence, and a drop's cast its ray);
 	 * the cells that pass are held for range_smear when it applies. The
 	 * counts stay until clearTailCandidates(). */
 	void countTailSamples(const ElevationGrid& frame, const BinnedPoints& samples, IsmStats& stats);
