@@ -458,7 +458,7 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 			if (k < minPoints() || ism::binomialTail(c.count, double(d.p0), k) >= alpha) continue;
 			// Its ground evidence stays if range_smear takes this back.
 			m_class[d.cell] = drop ? VoxelClass::Drop : VoxelClass::Obstacle;
-			hold(Held{d.cell, k, drop, drop && m_params.drop_rays, true}, smear, frame, stats);
+			hold(Held{d.cell, k, drop, true}, smear, frame, stats);
 			continue;
 		}
 		// An obstacle or a drop judged by its extreme sample: it takes as many
@@ -471,7 +471,7 @@ void InverseSensorModel::countTailSamples(const ElevationGrid& frame, const Binn
 			stats.sparse++;
 			continue;
 		}
-		hold(Held{d.cell, k, drop, drop && m_params.drop_rays, false}, smear, frame, stats);
+		hold(Held{d.cell, k, drop, false}, smear, frame, stats);
 	}
 }
 
@@ -492,7 +492,8 @@ void InverseSensorModel::give(const Held& h, const ElevationGrid& frame, IsmStat
 	}
 	(h.drop ? stats.drop : stats.obstacle)++;
 	put(h.cell, obstacleEvidence(frame.cell(h.cell), frame.geometry().resolution));
-	if (h.ray) m_dropVoxels.push_back(h.cell);
+	// A drop that counts casts its ray (it takes min_obstacle_points, as it counts).
+	if (h.drop && m_params.drop_rays) m_dropVoxels.push_back(h.cell);
 }
 
 void InverseSensorModel::clearTailCandidates()
@@ -669,7 +670,7 @@ void InverseSensorModel::compute(
 				}
 				if (deferred) break;
 				const bool drop = cls == VoxelClass::Drop;
-				hold(Held{idx, c.count, drop, drop && m_params.drop_rays, false}, smear, frame, stats);
+				hold(Held{idx, c.count, drop, false}, smear, frame, stats);
 				break;
 			}
 			case VoxelClass::OutOfRange: stats.out_of_range++; break;

@@ -516,12 +516,12 @@ class InverseSensorModel
 	{
 		uint32_t cell;
 		uint32_t beyond;
-		bool drop, ray, deep;
+		bool drop, deep;
 		bool smeared = false;
 	};
 	/** Gives the evidence now, or holds the cell for range_smear. */
 	void hold(const Held& h, bool smear, const ElevationGrid& frame, IsmStats& stats);
-	/** Puts an obstacle or drop cell's evidence (and its drop ray). */
+	/** Puts an obstacle or drop cell's evidence (and, with drop_rays, a drop's ray). */
 	void give(const Held& h, const ElevationGrid& frame, IsmStats& stats);
 	/** Whether range_smear applies (on, a noise model, a focal length). */
 	bool smearTest() const { return m_params.range_smear && m_params.noise_sigmas > 0 && m_fx > 0; }
