@@ -37,14 +37,15 @@ export LSAN_OPTIONS="suppressions=$here/tests/sanitizers/lsan.supp:print_suppres
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 mkdir -p "$build/artifacts"
 # MRPT 2.5's own deserializers still trust some counts in corrupt rawlogs (e.g. the
-# particle count of a CActionRobotMovement2D Thrun model): inputs that only run out
+# point count of a 3D scan): inputs that only run out
 # of memory inside MRPT are logged and skipped (fork mode, -ignore_ooms) unless
 # GAM_FUZZ_STOP_ON_OOM=1. Crashes, sanitizer reports, leaks and timeouts always stop.
 oom_flags="-fork=1 -ignore_ooms=1"
 [ "${GAM_FUZZ_STOP_ON_OOM:-0}" = 1 ] && oom_flags=""
 # Smoke mode (CI): GAM_FUZZ_RUNS=N runs at most N inputs per target (and at most
 # SECONDS), in one process, from the seeds alone (a fresh corpus folder), with the
-# fixed seed: the same inputs on every machine, so a passing smoke passes everywhere.
+# fixed seed. Not the same inputs on every run: coverage varies from run to run, and
+# with it the mutations libFuzzer keeps (doc/robustness.md).
 runs_flags=""
 if [ -n "${GAM_FUZZ_RUNS:-}" ]; then
   runs_flags="-runs=$GAM_FUZZ_RUNS"

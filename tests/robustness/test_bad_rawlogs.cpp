@@ -12,11 +12,13 @@
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservationGPS.h>
 #include <mrpt/obs/CObservationImage.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose2D.h>
+#include <mrpt/poses/CPosePDFGaussian.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <unistd.h>
@@ -316,6 +318,119 @@ TEST(RobustRawlogs, AbsurdElementCountIsAnErrorNotGigabytes)
 		EXPECT_TRUE(r.threw) << name;
 		EXPECT_NE(r.error.find("claims"), std::string::npos) << r.error;
 	}
+}
+
+namespace
+{
+/** A sensory-frame rawlog of two steps: a CActionCollection holding `move`, then a
+ * frame with one depth image. */
+std::string movementRawlog(const mrpt::obs::CActionRobotMovement2D& move)
+{
+	mrpt::io::CMemoryStream buf;
+	auto ar = mrpt::serialization::archiveFrom(buf);
+	for (int k = 0; k < 2; k++)
+	{
+		mrpt::obs::CActionCollection acts;
+		acts.insert(move);
+		ar << acts;
+		mrpt::obs::CSensoryFrame sf;
+		sf.insert(testscene::renderDepth(robust::floorAndBox(), robust::kMount, {}, 64, 48));
+		ar << sf;
+	}
+	return std::string(static_cast<const char*>(buf.getRawBufferData()), buf.getTotalBytesCount());
+}
+}  // namespace
+
+TEST(RobustRawlogs, AMovementWhosePosePdfIsAnotherClassIsAnErrorNotACrash)
+{
+	// Found by tests/fuzz/fuzz_rawlog (a SIGSEGV in CI): a CActionRobotMovement2D
+	// whose estimation method is not odometry reads a pose PDF; MRPT 2.5 turns a
+	// stored object of another class into a null pointer and clones it.
+	mrpt::obs::CActionRobotMovement2D odo;
+	odo.computeFromOdometry(mrpt::poses::CPose2D(0.5, 0, 0), {});
+	std::string bytes = movementRawlog(odo);
+
+	// As written: two frames, the robot 0.5 m further at each.
+	const std::string f = tmpFile("movement.rawlog");
+	spit(f, bytes);
+	{
+		RawlogFrameReader rd(f);
+		Frame fr;
+		ASSERT_TRUE(rd.next(fr));
+		EXPECT_NEAR(fr.robotPose.x(), 0.5, 1e-9);
+		ASSERT_TRUE(rd.next(fr));
+		EXPECT_NEAR(fr.robotPose.x(), 1.0, 1e-9);
+		EXPECT_FALSE(rd.next(fr));
+	}
+
+	// The estimation method (int32 after the class name and the version byte) set to
+	// 1, scan matching: what follows, the odometry's CPose2D, is read as the PDF.
+	const std::string name = "mrpt::obs::CActionRobotMovement2D";
+	const size_t at = bytes.find(name);
+	ASSERT_NE(at, std::string::npos);
+	ASSERT_EQ(bytes.substr(at + name.size() + 1, 4), std::string(4, '\0'));
+	bytes[at + name.size() + 1] = 1;
+	spit(f, bytes);
+	const auto r = readAll(f);
+	EXPECT_TRUE(r.threw);
+	EXPECT_EQ(r.frames, 0u);
+	EXPECT_NE(r.error.find("at entry 0"), std::string::npos) << r.error;
+	EXPECT_NE(r.error.find("'mrpt::poses::CPose2D' where its pose PDF should be"), std::string::npos) << r.error;
+
+	// The same as the first object of the file, outside a collection.
+	spit(f, bytes.substr(at - 1));
+	const auto r2 = readAll(f);
+	EXPECT_TRUE(r2.threw);
+	EXPECT_NE(r2.error.find("where its pose PDF should be"), std::string::npos) << r2.error;
+}
+
+TEST(RobustRawlogs, AnAbsurdMotionModelParticleCountIsAnErrorNotGigabytes)
+{
+	// Found by tests/fuzz/fuzz_rawlog: with odometry and Thrun's motion model, MRPT
+	// allocates the stored particle count before anything else is checked.
+	mrpt::obs::CActionRobotMovement2D odo;
+	mrpt::obs::CActionRobotMovement2D::TMotionModelOptions thrun;
+	thrun.modelSelection = mrpt::obs::CActionRobotMovement2D::mmThrun;
+	thrun.thrunModel.nParticlesCount = 4321;  // a count easy to find in the bytes
+	odo.computeFromOdometry(mrpt::poses::CPose2D(0.5, 0, 0), thrun);
+	std::string bytes = movementRawlog(odo);
+	const std::string f = tmpFile("particles.rawlog");
+	spit(f, bytes);
+	EXPECT_FALSE(readAll(f).threw);
+	EXPECT_EQ(readAll(f).frames, 2u);
+
+	const std::string count("\xe1\x10\x00\x00", 4);  // 4321, little-endian
+	const size_t at = bytes.find(count, bytes.find("mrpt::obs::CActionRobotMovement2D"));
+	ASSERT_NE(at, std::string::npos);
+	bytes.replace(at, 4, std::string("\x00\x00\x00\x40", 4));  // 2^30 particles
+	spit(f, bytes);
+	const auto r = readAll(f);
+	EXPECT_TRUE(r.threw);
+	EXPECT_NE(r.error.find("asks for 1073741824 motion-model particles"), std::string::npos) << r.error;
+}
+
+TEST(RobustRawlogs, AMovementFromScanMatchingMovesTheRobotByItsPdfMean)
+{
+	// The checked reading of action collections keeps a real PDF: scan matching,
+	// a Gaussian of mean (0.3, 0.1, 0.2 rad), gives frames at its mean, then twice it.
+	mrpt::obs::CActionRobotMovement2D sm;
+	sm.estimationMethod = mrpt::obs::CActionRobotMovement2D::emScan2DMatching;
+	sm.poseChange = mrpt::poses::CPosePDFGaussian::Create(mrpt::poses::CPose2D(0.3, 0.1, 0.2));
+	const std::string f = tmpFile("scan_matching.rawlog");
+	spit(f, movementRawlog(sm));
+	RawlogFrameReader rd(f);
+	Frame fr;
+	ASSERT_TRUE(rd.next(fr));
+	EXPECT_NEAR(fr.robotPose.x(), 0.3, 1e-9);
+	EXPECT_NEAR(fr.robotPose.y(), 0.1, 1e-9);
+	EXPECT_NEAR(fr.robotPose.yaw(), 0.2, 1e-9);
+	ASSERT_TRUE(rd.next(fr));
+	// (0.3, 0.1, 0.2) composed with itself: x = 0.3 + 0.3 cos 0.2 - 0.1 sin 0.2,
+	// y = 0.1 + 0.3 sin 0.2 + 0.1 cos 0.2, yaw 0.4.
+	EXPECT_NEAR(fr.robotPose.x(), 0.3 + 0.3 * std::cos(0.2) - 0.1 * std::sin(0.2), 1e-9);
+	EXPECT_NEAR(fr.robotPose.y(), 0.1 + 0.3 * std::sin(0.2) + 0.1 * std::cos(0.2), 1e-9);
+	EXPECT_NEAR(fr.robotPose.yaw(), 0.4, 1e-9);
+	EXPECT_FALSE(rd.next(fr));
 }
 
 TEST(RobustRawlogs, AbsurdStringLengthIsAnErrorNotGigabytes)

@@ -7,6 +7,7 @@
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CRawlog.h>
 #include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPosePDF.h>
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
 
@@ -15,6 +16,7 @@
 #include <cstring>
 #include <fstream>
 #include <new>
+#include <optional>
 #include <stdexcept>
 
 // MRPT 2.5's aligned_allocator_cpp11 (CMatrixDynamic, range images, point
@@ -114,23 +116,156 @@ class PeekStream : public mrpt::io::CStream
 	size_t m_pos = 0;
 };
 
+/** The header MRPT writes before every object, read without consuming it. New format
+ * (MRPT >= 0.5.5): byte 0x80|L, L name bytes, version byte (none for "nullptr"),
+ * and an end byte 0x88 after the object. Old format: uint32 L < 0x80, L name bytes,
+ * int32 version, no end byte. */
+struct ObjectHeader
+{
+	std::string name;
+	int version = -1;
+	size_t bytes = 0;  ///< header length
+	bool oldFormat = false;
+};
+
+/** The header of the object starting `at` bytes ahead; nullopt when it is cut short
+ * or malformed (MRPT's own reader then reports it). */
+std::optional<ObjectHeader> peekHeader(PeekStream& ps, size_t at)
+{
+	if (ps.peek(at + 1) < at + 1) return std::nullopt;
+	ObjectHeader h;
+	size_t L = ps.data()[at] & 0x7F, p = at + 1;
+	h.oldFormat = !(ps.data()[at] & 0x80);
+	if (h.oldFormat)
+	{
+		if (ps.peek(at + 4) < at + 4 || ps.data()[at + 1] || ps.data()[at + 2] || ps.data()[at + 3])
+			return std::nullopt;
+		p = at + 4;
+	}
+	if (ps.peek(p + L) < p + L) return std::nullopt;
+	h.name.assign(reinterpret_cast<const char*>(ps.data()) + p, L);
+	p += L;
+	if (!h.oldFormat && h.name == "nullptr")
+	{
+		h.bytes = p - at;
+		return h;
+	}
+	const size_t vbytes = h.oldFormat ? 4 : 1;
+	if (ps.peek(p + vbytes) < p + vbytes) return std::nullopt;
+	h.version = ps.data()[p];  // the old format's int32 is < 255 (MRPT asserts)
+	h.bytes = p + vbytes - at;
+	return h;
+}
+
+uint32_t peekU32(PeekStream& ps, size_t at)
+{
+	if (ps.peek(at + 4) < at + 4) return 0;
+	const uint8_t* c = ps.data() + at;
+	return uint32_t(c[0]) | uint32_t(c[1]) << 8 | uint32_t(c[2]) << 16 | uint32_t(c[3]) << 24;
+}
+
+/** Thrown with the whole message: the reader passes it on unchanged. */
+struct CorruptRawlog : std::runtime_error
+{
+	using std::runtime_error::runtime_error;
+};
+
 /** Rejects a CSensoryFrame / CActionCollection whose element count is absurd
- * (MRPT's format: byte 0x80|L, L name bytes, version byte, uint32 count LE). */
+ * (both formats: the header, then a uint32 count, little-endian). */
 void checkContainerCount(PeekStream& ps, const std::string& where)
 {
-	if (ps.peek(1) < 1 || !(ps.data()[0] & 0x80)) return;
-	const size_t L = ps.data()[0] & 0x7F;
-	if (ps.peek(1 + L) < 1 + L) return;
-	const std::string name(reinterpret_cast<const char*>(ps.data()) + 1, L);
-	if (name != "mrpt::obs::CSensoryFrame" && name != "mrpt::obs::CActionCollection") return;
-	if (ps.peek(1 + L + 5) < 1 + L + 5) return;
-	const uint8_t* c = ps.data() + 1 + L + 1;
-	const uint32_t n = uint32_t(c[0]) | uint32_t(c[1]) << 8 | uint32_t(c[2]) << 16 | uint32_t(c[3]) << 24;
+	const auto h = peekHeader(ps, 0);
+	if (!h || (h->name != "mrpt::obs::CSensoryFrame" && h->name != "mrpt::obs::CActionCollection")) return;
+	if (ps.peek(h->bytes + 4) < h->bytes + 4) return;
+	const uint32_t n = peekU32(ps, h->bytes);
 	constexpr uint32_t kMaxElements = 100000;
 	if (n > kMaxElements)
-		throw std::runtime_error(
-			where + " (corrupt: a " + name + " claims " + std::to_string(n) + " elements, limit " +
+		throw CorruptRawlog(
+			where + " (corrupt: a " + h->name + " claims " + std::to_string(n) + " elements, limit " +
 			std::to_string(kMaxElements) + ")");
+}
+
+/** Two checks of a CActionRobotMovement2D before MRPT 2.5 reads it (both found by
+ * tests/fuzz/fuzz_rawlog):
+ * - its pose PDF is read as a typed pointer: a stored object of another class (or
+ *   "nullptr") gives a null pointer, which MRPT then copies with clone(), a SIGSEGV
+ *   (here an estimation method other than odometry, so the odometry's CPose2D was
+ *   read as the PDF);
+ * - with odometry and Thrun's motion model, the stored particle count is allocated
+ *   as is: a corrupt one asks for gigabytes.
+ * Layout: versions 0-1 store the PDF first; versions >= 2 an int32 method, then the
+ * PDF unless the method is odometry (0); odometry (versions 3-7): the increment (a
+ * CPose2D object), int32 model (0 = Gaussian), 5 (version 3) or 6 floats, uint32
+ * particle count. */
+void checkRobotMovement2D(PeekStream& ps, size_t at, const std::string& where)
+{
+	const auto h = peekHeader(ps, at);
+	if (!h || h->name != "mrpt::obs::CActionRobotMovement2D") return;
+	size_t p = at + h->bytes;
+	const bool odometry = h->version >= 2 && ps.peek(p + 4) >= p + 4 && peekU32(ps, p) == 0;
+	if (h->version >= 2) p += 4;
+	if (odometry)
+	{
+		const auto inc = peekHeader(ps, p);
+		if (h->version < 3 || h->version > 7 || !inc || inc->name != "mrpt::poses::CPose2D" || inc->version > 1)
+			return;  // MRPT reports what it cannot read
+		p += inc->bytes + (inc->version == 0 ? 12 : 24) + (inc->oldFormat ? 0 : 1);
+		const uint32_t model = peekU32(ps, p);
+		p += 4 + (h->version == 3 ? 5 : 6) * 4;
+		if (ps.peek(p + 4) < p + 4) return;
+		const uint32_t particles = peekU32(ps, p);
+		constexpr uint32_t kMaxParticles = 100000;  // MRPT's default is 300
+		if (model != 0 && particles > kMaxParticles)
+			throw CorruptRawlog(
+				where + " (corrupt: a CActionRobotMovement2D asks for " + std::to_string(particles) +
+				" motion-model particles, limit " + std::to_string(kMaxParticles) + ")");
+		return;
+	}
+	const auto pdf = peekHeader(ps, p);
+	if (!pdf) return;
+	const auto* cls = mrpt::rtti::findRegisteredClass(pdf->name);
+	if (!cls || !cls->derivedFrom(CLASS_ID(mrpt::poses::CPosePDF)))
+		throw CorruptRawlog(
+			where + " (corrupt: a CActionRobotMovement2D holds a '" + pdf->name + "' where its pose PDF should be)");
+}
+
+/** Reads a CActionCollection element by element, so that each CActionRobotMovement2D
+ * is checked before MRPT reads it (MRPT's own reader reads them all in one call).
+ * Same wire format as CActionCollection version 0: header, uint32 count, the actions,
+ * end byte. Null or non-action elements are left out. */
+mrpt::obs::CActionCollection::Ptr readActionCollection(
+	PeekStream& ps, mrpt::serialization::CArchive& ar, const ObjectHeader& h, const std::string& where)
+{
+	std::vector<uint8_t> skip(h.bytes + 4);
+	if (ps.Read(skip.data(), skip.size()) != skip.size())
+		throw CorruptRawlog(where + " (corrupt: the file ends inside a CActionCollection)");
+	const uint32_t n = uint32_t(skip[h.bytes]) | uint32_t(skip[h.bytes + 1]) << 8 | uint32_t(skip[h.bytes + 2]) << 16 |
+					   uint32_t(skip[h.bytes + 3]) << 24;
+	auto acts = mrpt::obs::CActionCollection::Create();
+	for (uint32_t i = 0; i < n; i++)
+	{
+		checkRobotMovement2D(ps, 0, where);
+		if (auto a = ar.ReadObject<mrpt::obs::CAction>()) acts->insertPtr(a);
+	}
+	if (!h.oldFormat)
+	{
+		uint8_t end = 0;
+		if (ps.Read(&end, 1) != 1 || end != 0x88)
+			throw CorruptRawlog(where + " (corrupt: a CActionCollection without its end byte)");
+	}
+	return acts;
+}
+
+/** The next top-level object, with the checks above before MRPT reads it. */
+mrpt::serialization::CSerializable::Ptr readObject(PeekStream& ps, const std::string& where)
+{
+	checkContainerCount(ps, where);
+	checkRobotMovement2D(ps, 0, where);
+	auto ar = mrpt::serialization::archiveFrom(ps);
+	const auto h = peekHeader(ps, 0);
+	if (h && h->name == "mrpt::obs::CActionCollection" && h->version == 0)
+		return readActionCollection(ps, ar, *h, where);
+	return ar.ReadObject();
 }
 }  // namespace
 
@@ -233,11 +368,13 @@ bool RawlogFrameReader::next(Frame& f)
 
 		mrpt::serialization::CSerializable::Ptr obj;
 		PeekStream ps(m_in);
-		checkContainerCount(ps, "cannot read rawlog " + m_path + " at entry " + std::to_string(m_entry));
 		try
 		{
-			auto ar = mrpt::serialization::archiveFrom(ps);
-			obj = ar.ReadObject();
+			obj = readObject(ps, "cannot read rawlog " + m_path + " at entry " + std::to_string(m_entry));
+		}
+		catch (const CorruptRawlog&)
+		{
+			throw;
 		}
 		catch (const mrpt::serialization::CExceptionEOF&)
 		{
