@@ -168,6 +168,26 @@ TEST(RobustObservations, BadRangeUnitsAreAnError)
 	}
 }
 
+TEST(RobustObservations, TinyRangeUnitsPutEveryPointAtTheSensor)
+{
+	// Found by tests/fuzz/fuzz_rawlog (UBSan): rangeUnits 1e-13 made the flying-pixel
+	// tolerance, one cell in raw units (0.05 / 1e-13 = 5e11), overflow an int. Every
+	// depth is then 1e-13 x its raw value <= 6.6e-9 m: every point is at the sensor
+	// (min_range is 0). No map throws; the 2.5D map holds at most the sensor's cell,
+	// and the ground-aware grid, with no floor in view, adds nothing.
+	auto o = goodFrame();
+	o.rangeUnits = 1e-13f;
+	for (auto& m : allMaps())
+	{
+		const auto before = stateOf(*m.map);
+		EXPECT_NO_THROW(m.map->insertObservation(o, CPose3D())) << m.name;
+		if (const auto* e = dynamic_cast<const CElevation25DMap*>(m.map.get()))
+			EXPECT_LE(e->grid().observedCount(), 1u);
+		if (dynamic_cast<const CGroundAwareOccupancyGrid*>(m.map.get()))
+			EXPECT_EQ(stateOf(*m.map), before) << m.name << " changed";
+	}
+}
+
 TEST(RobustObservations, RangesBeyondAnySaneMaximumAreDropped)
 {
 	// Every pixel 65535 m away (rangeUnits 1), and the sensor claims a 1e6 m range.

@@ -382,6 +382,18 @@ TEST(RobustRawlogs, AMovementWhosePosePdfIsAnotherClassIsAnErrorNotACrash)
 	const auto r2 = readAll(f);
 	EXPECT_TRUE(r2.threw);
 	EXPECT_NE(r2.error.find("where its pose PDF should be"), std::string::npos) << r2.error;
+
+	// MRPT also finds a class by its name without the namespace: a collection named
+	// "mrpt::/bs::CActionCollection" is read as one (found by the fuzzer, past the
+	// first version of this check, which compared names).
+	std::string renamed = bytes;
+	const size_t ns = renamed.find("mrpt::obs::CActionCollection");
+	ASSERT_NE(ns, std::string::npos);
+	renamed[ns + 6] = '/';
+	spit(f, renamed);
+	const auto r3 = readAll(f);
+	EXPECT_TRUE(r3.threw);
+	EXPECT_NE(r3.error.find("where its pose PDF should be"), std::string::npos) << r3.error;
 }
 
 TEST(RobustRawlogs, AnAbsurdMotionModelParticleCountIsAnErrorNotGigabytes)
@@ -431,6 +443,51 @@ TEST(RobustRawlogs, AMovementFromScanMatchingMovesTheRobotByItsPdfMean)
 	EXPECT_NEAR(fr.robotPose.y(), 0.1 + 0.3 * std::sin(0.2) + 0.1 * std::cos(0.2), 1e-9);
 	EXPECT_NEAR(fr.robotPose.yaw(), 0.4, 1e-9);
 	EXPECT_FALSE(rd.next(fr));
+}
+
+TEST(RobustRawlogs, AnAbsurdPointCountIsAnErrorNotGigabytes)
+{
+	// Found by tests/fuzz/fuzz_rawlog: MRPT allocates a 3D scan's five point buffers
+	// (16 bytes a point) for the stored count before reading a point. 4321 points
+	// written, the count then set to 2^26, twice the limit: 1 GiB allocated before the
+	// read failed. Both as an observation and inside a sensory frame.
+	auto scan = mrpt::obs::CObservation3DRangeScan::Create();
+	scan->hasPoints3D = true;
+	scan->resizePoints3DVectors(4321);
+	for (size_t i = 0; i < 4321; i++)
+	{
+		scan->points3D_x[i] = 1.0f + 0.001f * float(i);
+		scan->points3D_y[i] = 0;
+		scan->points3D_z[i] = -1.0f;
+	}
+	for (const bool inFrame : {false, true})
+	{
+		mrpt::io::CMemoryStream buf;
+		auto ar = mrpt::serialization::archiveFrom(buf);
+		if (inFrame)
+		{
+			mrpt::obs::CSensoryFrame sf;
+			sf.insert(scan);
+			ar << sf;
+		}
+		else
+			ar << *scan;
+		std::string bytes(static_cast<const char*>(buf.getRawBufferData()), buf.getTotalBytesCount());
+		const std::string f = tmpFile("points.rawlog");
+		spit(f, bytes);
+		auto r = readAll(f);
+		EXPECT_FALSE(r.threw) << r.error;
+		EXPECT_EQ(r.frames, 1u);
+
+		const std::string count("\xe1\x10\x00\x00", 4);  // 4321, little-endian
+		const size_t at = bytes.find(count, bytes.find("mrpt::obs::CObservation3DRangeScan"));
+		ASSERT_NE(at, std::string::npos);
+		bytes.replace(at, 4, std::string("\x00\x00\x00\x04", 4));
+		spit(f, bytes);
+		r = readAll(f);
+		EXPECT_TRUE(r.threw) << inFrame;
+		EXPECT_NE(r.error.find("claims 67108864 points"), std::string::npos) << r.error;
+	}
 }
 
 TEST(RobustRawlogs, AbsurdStringLengthIsAnErrorNotGigabytes)

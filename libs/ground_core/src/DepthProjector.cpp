@@ -393,8 +393,11 @@ size_t DepthProjector::project(
 	float* rowZ = m_rowZ.data();
 	const bool useAvx2 = m_allowAvx2 && detail::avx2RowLoopAvailable();
 	// Flying pixels: one grid cell of tolerance (a smaller error moves a point
-	// by less than a cell), in image units.
-	const float flyTol = float(g.resolution / double(img.units));
+	// by less than a cell), in image units. Raw depths are 16-bit: a tolerance
+	// of 65536 units or more passes every difference alike, and the row pass
+	// takes it as an int (a corrupt rangeUnits of 1e-13 made it 5e11: found by
+	// tests/fuzz/fuzz_rawlog).
+	const float flyTol = float(std::min(g.resolution / double(img.units), 65536.0));
 	uint8_t* keep = m_rowKeep.data();
 	const FlyingBatch flyingBatch{m_flyCols.data(),  m_flyLines.data(),          size_t(K.width),
 								  m_flyAlong.data(), m_flyAgainstNothing.data(), m_flyZeros.data()};

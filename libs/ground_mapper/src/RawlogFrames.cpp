@@ -68,12 +68,12 @@ using namespace mrpt::obs;
 
 namespace
 {
-/** A read-only view of the rawlog stream that can look at the start of the next
- * object before MRPT deserializes it. MRPT 2.5 reads the element count of a
- * CSensoryFrame / CActionCollection and resizes its container to it before reading
- * any element: a corrupt count makes a 1 KB rawlog allocate tens of GB (found by
- * tests/fuzz/fuzz_rawlog). Peeked bytes never exceed the object being read, so the
- * buffer is always consumed by the following ReadObject(). */
+/** A read-only view of the rawlog stream that can look ahead into the next object
+ * before MRPT deserializes it (the checks below: counts MRPT 2.5 allocates before
+ * reading, pointers it does not check; found by tests/fuzz/fuzz_rawlog). In a
+ * well-formed rawlog the bytes peeked never go past the object being read, so the
+ * buffer is always consumed by the reads that follow; in a corrupt one what is left
+ * is lost with the reader's error. */
 class PeekStream : public mrpt::io::CStream
 {
    public:
@@ -123,9 +123,19 @@ class PeekStream : public mrpt::io::CStream
 struct ObjectHeader
 {
 	std::string name;
+	/** The class MRPT reads for `name`: it also finds a class by its name
+	 * without the namespace, so "mrpt::/bs::CActionCollection" is one too
+	 * (found by tests/fuzz/fuzz_rawlog). nullptr: none (MRPT reports it). */
+	const mrpt::rtti::TRuntimeClassId* cls = nullptr;
 	int version = -1;
 	size_t bytes = 0;  ///< header length
 	bool oldFormat = false;
+
+	template <class T>
+	bool is() const
+	{
+		return cls == CLASS_ID(T);
+	}
 };
 
 /** The header of the object starting `at` bytes ahead; nullopt when it is cut short
@@ -143,7 +153,9 @@ std::optional<ObjectHeader> peekHeader(PeekStream& ps, size_t at)
 		p = at + 4;
 	}
 	if (ps.peek(p + L) < p + L) return std::nullopt;
-	h.name.assign(reinterpret_cast<const char*>(ps.data()) + p, L);
+	// As MRPT reads it: a C string, so a NUL byte ends the name.
+	h.name = std::string(reinterpret_cast<const char*>(ps.data()) + p, L).c_str();
+	if (h.name != "nullptr") h.cls = mrpt::rtti::findRegisteredClass(h.name);
 	p += L;
 	if (!h.oldFormat && h.name == "nullptr")
 	{
@@ -170,19 +182,63 @@ struct CorruptRawlog : std::runtime_error
 	using std::runtime_error::runtime_error;
 };
 
-/** Rejects a CSensoryFrame / CActionCollection whose element count is absurd
- * (both formats: the header, then a uint32 count, little-endian). */
+/** Where a container's uint32 element count lies after its header:
+ * CActionCollection version 0, CSensoryFrame version 2 right after it; a
+ * CSensoryFrame of version 1 after a uint32 ID, of version 0 also after a
+ * timestamp. npos: not such a container. */
+size_t countOffset(const ObjectHeader& h)
+{
+	if (h.is<mrpt::obs::CActionCollection>()) return h.version == 0 ? 0 : std::string::npos;
+	if (h.is<mrpt::obs::CSensoryFrame>())
+		return h.version == 2 ? 0 : h.version == 1 ? 4 : h.version == 0 ? 12 : std::string::npos;
+	return std::string::npos;
+}
+
+/** Rejects a CSensoryFrame / CActionCollection whose element count is absurd. */
 void checkContainerCount(PeekStream& ps, const std::string& where)
 {
 	const auto h = peekHeader(ps, 0);
-	if (!h || (h->name != "mrpt::obs::CSensoryFrame" && h->name != "mrpt::obs::CActionCollection")) return;
-	if (ps.peek(h->bytes + 4) < h->bytes + 4) return;
-	const uint32_t n = peekU32(ps, h->bytes);
+	if (!h) return;
+	const size_t off = countOffset(*h);
+	if (off == std::string::npos) return;
+	const size_t at = h->bytes + off;
+	if (ps.peek(at + 4) < at + 4) return;
+	const uint32_t n = peekU32(ps, at);
 	constexpr uint32_t kMaxElements = 100000;
 	if (n > kMaxElements)
 		throw CorruptRawlog(
 			where + " (corrupt: a " + h->name + " claims " + std::to_string(n) + " elements, limit " +
 			std::to_string(kMaxElements) + ")");
+}
+
+/** MRPT 2.5's CObservation3DRangeScan allocates its five point buffers (x, y, z
+ * floats, two uint16 pixel indices: 16 bytes a point) for the stored count before
+ * reading a point: a corrupt count makes it ask for up to 1 GiB a buffer
+ * (mrpt::aligned_malloc's limit above), 4 GiB in all, before the read fails
+ * (found by tests/fuzz/fuzz_rawlog; the fuzzer's memory limit, a walker's
+ * computer's RAM). Layout: float maxRange, the sensor pose (a CPose3D object:
+ * version 3 is 12 doubles), bool hasPoints3D (not in version 0), uint32 count. */
+void checkRangeScan3D(PeekStream& ps, size_t at, const std::string& where)
+{
+	const auto h = peekHeader(ps, at);
+	if (!h || !h->is<mrpt::obs::CObservation3DRangeScan>()) return;
+	size_t p = at + h->bytes + 4;
+	const auto pose = peekHeader(ps, p);
+	if (!pose || !pose->is<mrpt::poses::CPose3D>() || pose->version != 3) return;
+	p += pose->bytes + 12 * 8 + (pose->oldFormat ? 0 : 1);
+	if (h->version >= 1)  // version 0 has points always, and no flag
+	{
+		if (ps.peek(p + 1) < p + 1 || ps.data()[p] == 0) return;
+		p += 1;
+	}
+	if (ps.peek(p + 4) < p + 4) return;
+	const uint32_t points = peekU32(ps, p);
+	// 2^25 points, 512 MiB: four times a 4096 x 2048 depth image.
+	constexpr uint32_t kMaxPoints = 1u << 25;
+	if (points > kMaxPoints)
+		throw CorruptRawlog(
+			where + " (corrupt: a CObservation3DRangeScan claims " + std::to_string(points) + " points, limit " +
+			std::to_string(kMaxPoints) + ")");
 }
 
 /** Two checks of a CActionRobotMovement2D before MRPT 2.5 reads it (both found by
@@ -200,14 +256,14 @@ void checkContainerCount(PeekStream& ps, const std::string& where)
 void checkRobotMovement2D(PeekStream& ps, size_t at, const std::string& where)
 {
 	const auto h = peekHeader(ps, at);
-	if (!h || h->name != "mrpt::obs::CActionRobotMovement2D") return;
+	if (!h || !h->is<mrpt::obs::CActionRobotMovement2D>()) return;
 	size_t p = at + h->bytes;
 	const bool odometry = h->version >= 2 && ps.peek(p + 4) >= p + 4 && peekU32(ps, p) == 0;
 	if (h->version >= 2) p += 4;
 	if (odometry)
 	{
 		const auto inc = peekHeader(ps, p);
-		if (h->version < 3 || h->version > 7 || !inc || inc->name != "mrpt::poses::CPose2D" || inc->version > 1)
+		if (h->version < 3 || h->version > 7 || !inc || !inc->is<mrpt::poses::CPose2D>() || inc->version > 1)
 			return;  // MRPT reports what it cannot read
 		p += inc->bytes + (inc->version == 0 ? 12 : 24) + (inc->oldFormat ? 0 : 1);
 		const uint32_t model = peekU32(ps, p);
@@ -223,48 +279,67 @@ void checkRobotMovement2D(PeekStream& ps, size_t at, const std::string& where)
 	}
 	const auto pdf = peekHeader(ps, p);
 	if (!pdf) return;
-	const auto* cls = mrpt::rtti::findRegisteredClass(pdf->name);
-	if (!cls || !cls->derivedFrom(CLASS_ID(mrpt::poses::CPosePDF)))
+	if (!pdf->cls || !pdf->cls->derivedFrom(CLASS_ID(mrpt::poses::CPosePDF)))
 		throw CorruptRawlog(
 			where + " (corrupt: a CActionRobotMovement2D holds a '" + pdf->name + "' where its pose PDF should be)");
 }
 
-/** Reads a CActionCollection element by element, so that each CActionRobotMovement2D
- * is checked before MRPT reads it (MRPT's own reader reads them all in one call).
- * Same wire format as CActionCollection version 0: header, uint32 count, the actions,
- * end byte. Null or non-action elements are left out. */
-mrpt::obs::CActionCollection::Ptr readActionCollection(
-	PeekStream& ps, mrpt::serialization::CArchive& ar, const ObjectHeader& h, const std::string& where)
+/** The checks of an object that MRPT would read in one go with its container. */
+void checkElement(PeekStream& ps, const std::string& where)
 {
-	std::vector<uint8_t> skip(h.bytes + 4);
-	if (ps.Read(skip.data(), skip.size()) != skip.size())
-		throw CorruptRawlog(where + " (corrupt: the file ends inside a CActionCollection)");
-	const uint32_t n = uint32_t(skip[h.bytes]) | uint32_t(skip[h.bytes + 1]) << 8 | uint32_t(skip[h.bytes + 2]) << 16 |
-					   uint32_t(skip[h.bytes + 3]) << 24;
-	auto acts = mrpt::obs::CActionCollection::Create();
+	checkRobotMovement2D(ps, 0, where);
+	checkRangeScan3D(ps, 0, where);
+}
+
+/** Reads a CActionCollection (version 0) or a CSensoryFrame (version 2) element by
+ * element, so that each element is checked before MRPT reads it (MRPT's own reader
+ * reads them all in one call). Their wire format: header, uint32 count, the
+ * elements, end byte. Null elements and elements of another base class are left
+ * out. */
+void add(mrpt::obs::CActionCollection& c, const mrpt::obs::CAction::Ptr& a) { c.insertPtr(a); }
+void add(mrpt::obs::CSensoryFrame& c, const mrpt::obs::CObservation::Ptr& o) { c.insert(o); }
+
+template <class Element, class Container>
+void readElements(
+	PeekStream& ps, mrpt::serialization::CArchive& ar, const ObjectHeader& h, const std::string& where, Container& into)
+{
+	std::vector<uint8_t> head(h.bytes + 4);
+	if (ps.Read(head.data(), head.size()) != head.size())
+		throw CorruptRawlog(where + " (corrupt: the file ends inside a " + h.name + ")");
+	const uint8_t* c = head.data() + h.bytes;
+	const uint32_t n = uint32_t(c[0]) | uint32_t(c[1]) << 8 | uint32_t(c[2]) << 16 | uint32_t(c[3]) << 24;
 	for (uint32_t i = 0; i < n; i++)
 	{
-		checkRobotMovement2D(ps, 0, where);
-		if (auto a = ar.ReadObject<mrpt::obs::CAction>()) acts->insertPtr(a);
+		checkElement(ps, where);
+		if (auto e = ar.ReadObject<Element>()) add(into, e);
 	}
 	if (!h.oldFormat)
 	{
 		uint8_t end = 0;
 		if (ps.Read(&end, 1) != 1 || end != 0x88)
-			throw CorruptRawlog(where + " (corrupt: a CActionCollection without its end byte)");
+			throw CorruptRawlog(where + " (corrupt: a " + h.name + " without its end byte)");
 	}
-	return acts;
 }
 
 /** The next top-level object, with the checks above before MRPT reads it. */
 mrpt::serialization::CSerializable::Ptr readObject(PeekStream& ps, const std::string& where)
 {
 	checkContainerCount(ps, where);
-	checkRobotMovement2D(ps, 0, where);
+	checkElement(ps, where);
 	auto ar = mrpt::serialization::archiveFrom(ps);
 	const auto h = peekHeader(ps, 0);
-	if (h && h->name == "mrpt::obs::CActionCollection" && h->version == 0)
-		return readActionCollection(ps, ar, *h, where);
+	if (h && h->is<mrpt::obs::CActionCollection>() && h->version == 0)
+	{
+		auto acts = mrpt::obs::CActionCollection::Create();
+		readElements<mrpt::obs::CAction>(ps, ar, *h, where, *acts);
+		return acts;
+	}
+	if (h && h->is<mrpt::obs::CSensoryFrame>() && h->version == 2)
+	{
+		auto sf = mrpt::obs::CSensoryFrame::Create();
+		readElements<mrpt::obs::CObservation>(ps, ar, *h, where, *sf);
+		return sf;
+	}
 	return ar.ReadObject();
 }
 }  // namespace
