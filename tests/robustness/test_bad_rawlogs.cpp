@@ -124,6 +124,16 @@ ReadOutcome readAll(const std::string& path)
 	}
 	return r;
 }
+
+/** Writes `bytes` as a rawlog and reads it all: an error whose message holds `what`. */
+void expectReadError(const std::string& bytes, const std::string& what)
+{
+	const std::string f = tmpFile("corrupt.rawlog");
+	spit(f, bytes);
+	const auto r = readAll(f);
+	EXPECT_TRUE(r.threw) << what;
+	EXPECT_NE(r.error.find(what), std::string::npos) << r.error;
+}
 }  // namespace
 
 TEST(RobustRawlogs, EmptyFilesEndCleanlyWithNoFrames)
@@ -370,18 +380,12 @@ TEST(RobustRawlogs, AMovementWhosePosePdfIsAnotherClassIsAnErrorNotACrash)
 	ASSERT_NE(at, std::string::npos);
 	ASSERT_EQ(bytes.substr(at + name.size() + 1, 4), std::string(4, '\0'));
 	bytes[at + name.size() + 1] = 1;
-	spit(f, bytes);
-	const auto r = readAll(f);
-	EXPECT_TRUE(r.threw);
-	EXPECT_EQ(r.frames, 0u);
-	EXPECT_NE(r.error.find("at entry 0"), std::string::npos) << r.error;
-	EXPECT_NE(r.error.find("'mrpt::poses::CPose2D' where its pose PDF should be"), std::string::npos) << r.error;
+	expectReadError(
+		bytes,
+		"at entry 0 (corrupt: a CActionRobotMovement2D holds a 'mrpt::poses::CPose2D' where its pose PDF should be)");
 
 	// The same as the first object of the file, outside a collection.
-	spit(f, bytes.substr(at - 1));
-	const auto r2 = readAll(f);
-	EXPECT_TRUE(r2.threw);
-	EXPECT_NE(r2.error.find("where its pose PDF should be"), std::string::npos) << r2.error;
+	expectReadError(bytes.substr(at - 1), "where its pose PDF should be");
 
 	// MRPT also finds a class by its name without the namespace: a collection named
 	// "mrpt::/bs::CActionCollection" is read as one (found by the fuzzer, past the
@@ -390,10 +394,7 @@ TEST(RobustRawlogs, AMovementWhosePosePdfIsAnotherClassIsAnErrorNotACrash)
 	const size_t ns = renamed.find("mrpt::obs::CActionCollection");
 	ASSERT_NE(ns, std::string::npos);
 	renamed[ns + 6] = '/';
-	spit(f, renamed);
-	const auto r3 = readAll(f);
-	EXPECT_TRUE(r3.threw);
-	EXPECT_NE(r3.error.find("where its pose PDF should be"), std::string::npos) << r3.error;
+	expectReadError(renamed, "where its pose PDF should be");
 }
 
 TEST(RobustRawlogs, AnAbsurdMotionModelParticleCountIsAnErrorNotGigabytes)
@@ -415,10 +416,7 @@ TEST(RobustRawlogs, AnAbsurdMotionModelParticleCountIsAnErrorNotGigabytes)
 	const size_t at = bytes.find(count, bytes.find("mrpt::obs::CActionRobotMovement2D"));
 	ASSERT_NE(at, std::string::npos);
 	bytes.replace(at, 4, std::string("\x00\x00\x00\x40", 4));  // 2^30 particles
-	spit(f, bytes);
-	const auto r = readAll(f);
-	EXPECT_TRUE(r.threw);
-	EXPECT_NE(r.error.find("asks for 1073741824 motion-model particles"), std::string::npos) << r.error;
+	expectReadError(bytes, "asks for 1073741824 motion-model particles");
 }
 
 TEST(RobustRawlogs, AMovementFromScanMatchingMovesTheRobotByItsPdfMean)
@@ -475,7 +473,7 @@ TEST(RobustRawlogs, AnAbsurdPointCountIsAnErrorNotGigabytes)
 		std::string bytes(static_cast<const char*>(buf.getRawBufferData()), buf.getTotalBytesCount());
 		const std::string f = tmpFile("points.rawlog");
 		spit(f, bytes);
-		auto r = readAll(f);
+		const auto r = readAll(f);
 		EXPECT_FALSE(r.threw) << r.error;
 		EXPECT_EQ(r.frames, 1u);
 
@@ -483,10 +481,7 @@ TEST(RobustRawlogs, AnAbsurdPointCountIsAnErrorNotGigabytes)
 		const size_t at = bytes.find(count, bytes.find("mrpt::obs::CObservation3DRangeScan"));
 		ASSERT_NE(at, std::string::npos);
 		bytes.replace(at, 4, std::string("\x00\x00\x00\x04", 4));
-		spit(f, bytes);
-		r = readAll(f);
-		EXPECT_TRUE(r.threw) << inFrame;
-		EXPECT_NE(r.error.find("claims 67108864 points"), std::string::npos) << r.error;
+		expectReadError(bytes, "claims 67108864 points");
 	}
 }
 
