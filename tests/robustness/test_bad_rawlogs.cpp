@@ -485,6 +485,30 @@ TEST(RobustRawlogs, AnAbsurdPointCountIsAnErrorNotGigabytes)
 	}
 }
 
+TEST(RobustRawlogs, AContainerHoldingAnotherKindOfObjectIsAnError)
+{
+	// Found by tests/fuzz/fuzz_rawlog: an action collection whose element is another
+	// action collection, which MRPT read in full (its count allocated as is) only to
+	// drop it: a corrupt rawlog. So is a sensory frame holding an action collection.
+	for (const bool inFrame : {false, true})
+	{
+		mrpt::io::CMemoryStream buf;
+		auto ar = mrpt::serialization::archiveFrom(buf);
+		const std::string inner = "\x9cmrpt::obs::CActionCollection";  // an empty collection
+		const std::string outer = inFrame ? "mrpt::obs::CSensoryFrame" : "mrpt::obs::CActionCollection";
+		std::string bytes;
+		bytes += char(0x80 | outer.size());
+		bytes += outer;
+		bytes += char(inFrame ? 2 : 0);               // version
+		bytes += std::string("\x01\x00\x00\x00", 4);  // one element
+		bytes += inner;
+		bytes += char(0);               // its version
+		bytes += std::string(4, '\0');  // no elements
+		bytes += "\x88\x88";            // the end bytes of both
+		expectReadError(bytes, "holds a 'mrpt::obs::CActionCollection'");
+	}
+}
+
 TEST(RobustRawlogs, AbsurdStringLengthIsAnErrorNotGigabytes)
 {
 	// Found by tests/fuzz/fuzz_rawlog: a corrupt string length (here in a camera

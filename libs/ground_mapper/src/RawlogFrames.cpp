@@ -294,8 +294,8 @@ void checkElement(PeekStream& ps, const std::string& where)
 /** Reads a CActionCollection (version 0) or a CSensoryFrame (version 2) element by
  * element, so that each element is checked before MRPT reads it (MRPT's own reader
  * reads them all in one call). Their wire format: header, uint32 count, the
- * elements, end byte. Null elements and elements of another base class are left
- * out. */
+ * elements, end byte. Null elements are left out; an element of another base class
+ * is an error. */
 void add(mrpt::obs::CActionCollection& c, const mrpt::obs::CAction::Ptr& a) { c.insertPtr(a); }
 void add(mrpt::obs::CSensoryFrame& c, const mrpt::obs::CObservation::Ptr& o) { c.insert(o); }
 
@@ -310,6 +310,11 @@ void readElements(
 	const uint32_t n = uint32_t(c[0]) | uint32_t(c[1]) << 8 | uint32_t(c[2]) << 16 | uint32_t(c[3]) << 24;
 	for (uint32_t i = 0; i < n; i++)
 	{
+		// An element of another class would be read in full by MRPT, unchecked
+		// (a collection inside a collection: its count allocated as is; found by
+		// tests/fuzz/fuzz_rawlog), then dropped: it is corrupt data.
+		if (const auto e = peekHeader(ps, 0); e && e->cls && !e->cls->derivedFrom(CLASS_ID(Element)))
+			throw CorruptRawlog(where + " (corrupt: a " + h.name + " holds a '" + e->name + "')");
 		checkElement(ps, where);
 		if (auto e = ar.ReadObject<Element>()) add(into, e);
 	}
