@@ -37,8 +37,8 @@ export LSAN_OPTIONS="suppressions=$here/tests/sanitizers/lsan.supp:print_suppres
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 mkdir -p "$build/artifacts"
 # MRPT 2.5's own deserializers still trust some counts in corrupt rawlogs (e.g. the
-# point count of a 3D scan): inputs that only run out
-# of memory inside MRPT are logged and skipped (fork mode, -ignore_ooms) unless
+# measurement count of a CObservationRange): inputs that only run out of memory
+# inside MRPT are logged and skipped (fork mode, -ignore_ooms) unless
 # GAM_FUZZ_STOP_ON_OOM=1. Crashes, sanitizer reports, leaks and timeouts always stop.
 oom_flags="-fork=1 -ignore_ooms=1"
 [ "${GAM_FUZZ_STOP_ON_OOM:-0}" = 1 ] && oom_flags=""

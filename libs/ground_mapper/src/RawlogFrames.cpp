@@ -169,12 +169,12 @@ std::optional<ObjectHeader> peekHeader(PeekStream& ps, size_t at)
 	return h;
 }
 
-uint32_t peekU32(PeekStream& ps, size_t at)
+uint32_t le32(const uint8_t* c)
 {
-	if (ps.peek(at + 4) < at + 4) return 0;
-	const uint8_t* c = ps.data() + at;
 	return uint32_t(c[0]) | uint32_t(c[1]) << 8 | uint32_t(c[2]) << 16 | uint32_t(c[3]) << 24;
 }
+
+uint32_t peekU32(PeekStream& ps, size_t at) { return ps.peek(at + 4) < at + 4 ? 0 : le32(ps.data() + at); }
 
 /** Thrown with the whole message: the reader passes it on unchanged. */
 struct CorruptRawlog : std::runtime_error
@@ -194,20 +194,19 @@ size_t countOffset(const ObjectHeader& h)
 	return std::string::npos;
 }
 
-/** Rejects a CSensoryFrame / CActionCollection whose element count is absurd. */
-void checkContainerCount(PeekStream& ps, const std::string& where)
+/** Rejects a CSensoryFrame / CActionCollection (header h, at the stream's start)
+ * whose element count is absurd. */
+void checkContainerCount(PeekStream& ps, const ObjectHeader& h, const std::string& where)
 {
-	const auto h = peekHeader(ps, 0);
-	if (!h) return;
-	const size_t off = countOffset(*h);
+	const size_t off = countOffset(h);
 	if (off == std::string::npos) return;
-	const size_t at = h->bytes + off;
+	const size_t at = h.bytes + off;
 	if (ps.peek(at + 4) < at + 4) return;
 	const uint32_t n = peekU32(ps, at);
 	constexpr uint32_t kMaxElements = 100000;
 	if (n > kMaxElements)
 		throw CorruptRawlog(
-			where + " (corrupt: a " + h->name + " claims " + std::to_string(n) + " elements, limit " +
+			where + " (corrupt: a " + h.name + " claims " + std::to_string(n) + " elements, limit " +
 			std::to_string(kMaxElements) + ")");
 }
 
@@ -218,15 +217,14 @@ void checkContainerCount(PeekStream& ps, const std::string& where)
  * (found by tests/fuzz/fuzz_rawlog; the fuzzer's memory limit, a walker's
  * computer's RAM). Layout: float maxRange, the sensor pose (a CPose3D object:
  * version 3 is 12 doubles), bool hasPoints3D (not in version 0), uint32 count. */
-void checkRangeScan3D(PeekStream& ps, size_t at, const std::string& where)
+void checkRangeScan3D(PeekStream& ps, const ObjectHeader& h, const std::string& where)
 {
-	const auto h = peekHeader(ps, at);
-	if (!h || !h->is<mrpt::obs::CObservation3DRangeScan>()) return;
-	size_t p = at + h->bytes + 4;
+	if (!h.is<mrpt::obs::CObservation3DRangeScan>()) return;
+	size_t p = h.bytes + 4;
 	const auto pose = peekHeader(ps, p);
 	if (!pose || !pose->is<mrpt::poses::CPose3D>() || pose->version != 3) return;
 	p += pose->bytes + 12 * 8 + (pose->oldFormat ? 0 : 1);
-	if (h->version >= 1)  // version 0 has points always, and no flag
+	if (h.version >= 1)  // version 0 has points always, and no flag
 	{
 		if (ps.peek(p + 1) < p + 1 || ps.data()[p] == 0) return;
 		p += 1;
@@ -253,21 +251,20 @@ void checkRangeScan3D(PeekStream& ps, size_t at, const std::string& where)
  * PDF unless the method is odometry (0); odometry (versions 3-7): the increment (a
  * CPose2D object), int32 model (0 = Gaussian), 5 (version 3) or 6 floats, uint32
  * particle count. */
-void checkRobotMovement2D(PeekStream& ps, size_t at, const std::string& where)
+void checkRobotMovement2D(PeekStream& ps, const ObjectHeader& h, const std::string& where)
 {
-	const auto h = peekHeader(ps, at);
-	if (!h || !h->is<mrpt::obs::CActionRobotMovement2D>()) return;
-	size_t p = at + h->bytes;
-	const bool odometry = h->version >= 2 && ps.peek(p + 4) >= p + 4 && peekU32(ps, p) == 0;
-	if (h->version >= 2) p += 4;
+	if (!h.is<mrpt::obs::CActionRobotMovement2D>()) return;
+	size_t p = h.bytes;
+	const bool odometry = h.version >= 2 && ps.peek(p + 4) >= p + 4 && peekU32(ps, p) == 0;
+	if (h.version >= 2) p += 4;
 	if (odometry)
 	{
 		const auto inc = peekHeader(ps, p);
-		if (h->version < 3 || h->version > 7 || !inc || !inc->is<mrpt::poses::CPose2D>() || inc->version > 1)
+		if (h.version < 3 || h.version > 7 || !inc || !inc->is<mrpt::poses::CPose2D>() || inc->version > 1)
 			return;  // MRPT reports what it cannot read
 		p += inc->bytes + (inc->version == 0 ? 12 : 24) + (inc->oldFormat ? 0 : 1);
 		const uint32_t model = peekU32(ps, p);
-		p += 4 + (h->version == 3 ? 5 : 6) * 4;
+		p += 4 + (h.version == 3 ? 5 : 6) * 4;
 		if (ps.peek(p + 4) < p + 4) return;
 		const uint32_t particles = peekU32(ps, p);
 		constexpr uint32_t kMaxParticles = 100000;  // MRPT's default is 300
@@ -284,21 +281,23 @@ void checkRobotMovement2D(PeekStream& ps, size_t at, const std::string& where)
 			where + " (corrupt: a CActionRobotMovement2D holds a '" + pdf->name + "' where its pose PDF should be)");
 }
 
-/** The checks of an object that MRPT would read in one go with its container. */
-void checkElement(PeekStream& ps, const std::string& where)
+/** The checks of the object at the stream's start (header h) that MRPT would
+ * otherwise read in one go, alone or with its container. */
+void checkObject(PeekStream& ps, const ObjectHeader& h, const std::string& where)
 {
-	checkRobotMovement2D(ps, 0, where);
-	checkRangeScan3D(ps, 0, where);
+	checkContainerCount(ps, h, where);
+	checkRobotMovement2D(ps, h, where);
+	checkRangeScan3D(ps, h, where);
 }
+
+void add(mrpt::obs::CActionCollection& c, const mrpt::obs::CAction::Ptr& a) { c.insertPtr(a); }
+void add(mrpt::obs::CSensoryFrame& c, const mrpt::obs::CObservation::Ptr& o) { c.insert(o); }
 
 /** Reads a CActionCollection (version 0) or a CSensoryFrame (version 2) element by
  * element, so that each element is checked before MRPT reads it (MRPT's own reader
  * reads them all in one call). Their wire format: header, uint32 count, the
  * elements, end byte. Null elements are left out; an element of another base class
  * is an error. */
-void add(mrpt::obs::CActionCollection& c, const mrpt::obs::CAction::Ptr& a) { c.insertPtr(a); }
-void add(mrpt::obs::CSensoryFrame& c, const mrpt::obs::CObservation::Ptr& o) { c.insert(o); }
-
 template <class Element, class Container>
 void readElements(
 	PeekStream& ps, mrpt::serialization::CArchive& ar, const ObjectHeader& h, const std::string& where, Container& into)
@@ -306,16 +305,18 @@ void readElements(
 	std::vector<uint8_t> head(h.bytes + 4);
 	if (ps.Read(head.data(), head.size()) != head.size())
 		throw CorruptRawlog(where + " (corrupt: the file ends inside a " + h.name + ")");
-	const uint8_t* c = head.data() + h.bytes;
-	const uint32_t n = uint32_t(c[0]) | uint32_t(c[1]) << 8 | uint32_t(c[2]) << 16 | uint32_t(c[3]) << 24;
+	const uint32_t n = le32(head.data() + h.bytes);
 	for (uint32_t i = 0; i < n; i++)
 	{
 		// An element of another class would be read in full by MRPT, unchecked
 		// (a collection inside a collection: its count allocated as is; found by
 		// tests/fuzz/fuzz_rawlog), then dropped: it is corrupt data.
-		if (const auto e = peekHeader(ps, 0); e && e->cls && !e->cls->derivedFrom(CLASS_ID(Element)))
-			throw CorruptRawlog(where + " (corrupt: a " + h.name + " holds a '" + e->name + "')");
-		checkElement(ps, where);
+		if (const auto e = peekHeader(ps, 0))
+		{
+			if (e->cls && !e->cls->derivedFrom(CLASS_ID(Element)))
+				throw CorruptRawlog(where + " (corrupt: a " + h.name + " holds a '" + e->name + "')");
+			checkObject(ps, *e, where);
+		}
 		if (auto e = ar.ReadObject<Element>()) add(into, e);
 	}
 	if (!h.oldFormat)
@@ -329,10 +330,9 @@ void readElements(
 /** The next top-level object, with the checks above before MRPT reads it. */
 mrpt::serialization::CSerializable::Ptr readObject(PeekStream& ps, const std::string& where)
 {
-	checkContainerCount(ps, where);
-	checkElement(ps, where);
 	auto ar = mrpt::serialization::archiveFrom(ps);
 	const auto h = peekHeader(ps, 0);
+	if (h) checkObject(ps, *h, where);
 	if (h && h->is<mrpt::obs::CActionCollection>() && h->version == 0)
 	{
 		auto acts = mrpt::obs::CActionCollection::Create();
