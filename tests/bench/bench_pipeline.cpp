@@ -96,10 +96,16 @@ std::vector<Dataset> g_data;
 // Each stage as it runs inside the real pipeline (gam::GroundAwarePipeline, the
 // object CGroundAwareOccupancyGrid runs): every iteration processes the next
 // frame and reports that stage's own timer (manual time).
-void BM_Stage(benchmark::State& st, const Dataset* d, double gam::StageTimes::*stage)
+void BM_Stage(benchmark::State& st, const Dataset* d, double gam::StageTimes::*stage, bool paperMode)
 {
 	const CGroundAwareOccupancyGrid grid;  // its default options and cell lattice
-	gam::GroundAwarePipeline pipeline(grid.groundOptions().pipeline);
+	gam::PipelineParams params = grid.groundOptions().pipeline;
+	if (paperMode)  // ism_model = rrt_variant = paper
+	{
+		params.ism.model = gam::MethodVariant::Paper;
+		params.rrt.variant = gam::MethodVariant::Paper;
+	}
+	gam::GroundAwarePipeline pipeline(params);
 	const gam::GridLattice lattice{grid.getXMin(), grid.getYMin(), grid.getResolution()};
 	size_t i = 0, samples = 0, ok = 0, n = 0;
 	for (auto _ : st)
@@ -369,10 +375,15 @@ int main(int argc, char** argv)
 			{"3_rrt_gpd", &gam::StageTimes::ground},
 			{"4_ism", &gam::StageTimes::ism},
 			{"4_missing_floor", &gam::StageTimes::missing}};
-		for (const auto& [name, stage] : stageCases)
-			benchmark::RegisterBenchmark((n + name).c_str(), BM_Stage, &d, stage)
-				->UseManualTime()
-				->Unit(benchmark::kMillisecond);
+		for (const bool paperMode : {false, true})
+			for (const auto& [name, stage] : stageCases)
+			{
+				if (paperMode && stage == &gam::StageTimes::missing) continue;  // paper mode has none
+				benchmark::RegisterBenchmark(
+					(n + (paperMode ? "paper_" : "") + name).c_str(), BM_Stage, &d, stage, paperMode)
+					->UseManualTime()
+					->Unit(benchmark::kMillisecond);
+			}
 		benchmark::RegisterBenchmark((n + "5_leddar").c_str(), BM_LeddarInsertion, &d)->Unit(benchmark::kMillisecond);
 		benchmark::RegisterBenchmark((n + "6_whole_pipeline").c_str(), BM_WholeMap<CGroundAwareOccupancyGrid>, &d)
 			->Unit(benchmark::kMillisecond);

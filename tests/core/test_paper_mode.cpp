@@ -153,6 +153,69 @@ TEST(PaperIsm, RayFanByHand)
 	EXPECT_EQ(fan.lastSample(0.02), -1);
 }
 
+TEST(PaperIsm, RayFanBinIsTheNearestRayToAtan2sAngle)
+{
+	// binOf() takes the angle from a series (atanReduced) and atan2 only near
+	// a bin's edge. Its bin must be the definition's: lround(atan2(dy, dx) /
+	// dtheta) modulo the bins, for every direction, the hard ones included:
+	// the axes and diagonals, signed zeros, and directions on a bin's edge and
+	// one unit in the last place either side of it.
+	const auto byDefinition = [](const paper::RayFan& f, double dx, double dy) {
+		const long b = std::lround(std::atan2(dy, dx) / f.dtheta);
+		return int(((b % f.bins) + f.bins) % f.bins);
+	};
+	std::mt19937_64 rng(7);
+	std::uniform_real_distribution<double> coord(-6.0, 6.0), turn(-M_PI, M_PI);
+	for (const auto& [res, range] : {std::pair{0.05, 4.5}, {0.05, 8.0}, {0.02, 10.0}, {0.1, 1.0}})
+	{
+		const paper::RayFan fan(res, range);
+		std::vector<std::pair<double, double>> dirs = {
+			{1, 0},
+			{-1, 0},
+			{0, 1},
+			{0, -1},
+			{1, 1},
+			{-1, 1},
+			{1, -1},
+			{-1, -1},
+			{0.0, 0.0},
+			{-1.0, -0.0},
+			{-1.0, 0.0},
+			{1.0, -0.0},
+			{0.0, -0.0},
+			{-0.0, 0.0},
+			{3.0, 1e-300},
+			{1e-300, 3.0},
+			{2.5, 2.5 * std::tan(M_PI / 16)}};
+		for (int k = -fan.bins / 2 - 1; k <= fan.bins / 2 + 1; k++)  // each bin's edge, and one ulp either side
+		{
+			const double edge = (k + 0.5) * fan.dtheta;
+			for (const double a : {std::nextafter(edge, -10.0), edge, std::nextafter(edge, 10.0)})
+				dirs.push_back({std::cos(a), std::sin(a)});
+		}
+		for (int i = 0; i < 200000; i++) dirs.push_back({coord(rng), coord(rng)});
+		for (int i = 0; i < 20000; i++)
+		{
+			const double a = turn(rng), r = 0.01 + 5.0 * std::abs(coord(rng));
+			dirs.push_back({r * std::cos(a), r * std::sin(a)});
+		}
+		size_t wrong = 0;
+		for (const auto& [dx, dy] : dirs)
+			if (fan.binOf(dx, dy) != byDefinition(fan, dx, dy) && wrong++ < 5)
+				ADD_FAILURE() << "res " << res << " range " << range << " (" << dx << ", " << dy
+							  << "): " << fan.binOf(dx, dy) << " instead of " << byDefinition(fan, dx, dy);
+		EXPECT_EQ(wrong, 0u) << "of " << dirs.size() << " directions";
+	}
+	// The series itself against std::atan, over [0, 1].
+	double worst = 0;
+	for (int i = 0; i <= 1000000; i++)
+	{
+		const double z = i / 1e6;
+		worst = std::max(worst, std::abs(paper::RayFan::atanReduced(z) - std::atan(z)));
+	}
+	EXPECT_LT(worst, 1e-10);
+}
+
 TEST(PaperIsm, SweepingEachRayOnceEqualsWalkingEveryVoxelsRay)
 {
 	// compute() sweeps each ray bin once from far to near, keeping only the

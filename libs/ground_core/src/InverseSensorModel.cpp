@@ -74,26 +74,6 @@ float kthSmallest(float* v, size_t n, size_t k)
 }
 }  // namespace ism
 
-namespace paper
-{
-double voxelVolume(double span, double resolution) { return resolution * resolution * std::max(span, resolution); }
-double densityConfidence(uint32_t count, double span, const IsmParams& p, double resolution)
-{
-	return p.K_m / (1.0 + std::exp(-p.K_n * (double(count) - p.d_min) / voxelVolume(span, resolution)));
-}
-double obstacleRay(double cDist, double cvDist, double pRho, const IsmParams& p)
-{
-	if (cDist > cvDist) return 0.5;  // eq. (6): behind the voxel, no evidence
-	const double d = cDist - cvDist;
-	return std::max(pRho, 0.5) * std::exp(-d * d / (2.0 * p.sigma2));
-}
-double groundRay(double cDist, double cvDist, const IsmParams& p)
-{
-	if (cDist > cvDist) return 0.5;
-	return p.K_g + (0.5 - p.K_g) / (1.0 + std::exp(-(cDist - cvDist)));
-}
-}  // namespace paper
-
 double InverseSensorModel::rangeFrom(const Eigen::Vector3d& sensor, double x, double y, double z)
 {
 	const double dx = x - sensor.x(), dy = y - sensor.y(), dz = z - sensor.z();
@@ -222,17 +202,6 @@ VoxelClass InverseSensorModel::classify(
 		if (dMean < -meanBand) return VoxelClass::Drop;
 	}
 	return VoxelClass::Ground;
-}
-
-void InverseSensorModel::put(uint32_t cell, float p)
-{
-	float& e = m_evidence[cell];
-	const bool wasNeutral = e == 0.5f;
-	e = ism::combine(e, p);
-	// List a cell once, when it first leaves 0.5 (combine never brings it back).
-	// Evidence of exactly 0.5 (K_g = 0 or K_m = 0) is no evidence: listing it
-	// put neutral cells, and duplicates, into evidenceCells().
-	if (wasNeutral && e != 0.5f) m_evidenceCells.push_back(cell);
 }
 
 void InverseSensorModel::buildSupport(const GridGeometry& g, const GroundDetection& det)
@@ -773,6 +742,29 @@ void InverseSensorModel::compute(
 	}
 }
 
+namespace
+{
+/** floor(offset / res) as GridGeometry::ix() takes it, without its division
+ * and its call to floor() (a library call without SSE4.1): the product
+ * offset * invRes (invRes = 1 / res) differs from the quotient by at most
+ * 3.4e-16 of it, under 1e-9 for a quotient below 1e6, so where the product
+ * is in [0, 1e6) and more than 1e-9 from an integer, its truncation is the
+ * quotient's floor. Elsewhere (a negative index, a NaN, near a cell's
+ * border) the division decides. */
+inline bool fastCellIndex(double q, int& i)
+{
+	const bool inRange = q >= 0 && q < 1e6;  // false for a NaN
+	i = int(inRange ? q : 0.0);
+	const double frac = q - double(i);
+	return inRange & (frac > 1e-9) & (frac < 1.0 - 1e-9);
+}
+inline int cellIndex(double offset, double res, double invRes)
+{
+	int i;
+	return fastCellIndex(offset * invRes, i) ? i : GridGeometry::toIndex(std::floor(offset / res));
+}
+}  // namespace
+
 void InverseSensorModel::computePaper(
 	const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, IsmStats& stats)
 {
@@ -790,14 +782,21 @@ void InverseSensorModel::computePaper(
 	const paper::RayFan fan(res, m_maxRange);
 	const float floorP = ism::kEvidenceFloor;
 	const bool groundAtLeastFloor = float(m_params.K_g) >= floorP;
+	const double invRes = 1.0 / res;
 
 	// 1. Classify every voxel in range (ground: both ends within d_pth); its
 	// own cell gets eq. (5) at |c| = |c_v|.
 	m_paperVoxels.clear();
+	const double invNx = 1.0 / g.nx;
+	const float groundOwn = float(paper::groundRay(0, 0, m_params));
 	for (uint32_t idx : frame.observedCells())
 	{
 		const ElevationCell& c = frame.cell(idx);
-		const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
+		// idx / nx without a division: the product is within one of it.
+		int cy = int(double(idx) * invNx);
+		cy -= int(uint32_t(cy) * uint32_t(g.nx) > idx);
+		cy += int(uint32_t(cy + 1) * uint32_t(g.nx) <= idx);
+		const int cx = int(idx - uint32_t(cy) * uint32_t(g.nx));
 		const double x = g.cx(cx), y = g.cy(cy);
 		const double dx = x - sx, dy = y - sy;
 		const double r2 = dx * dx + dy * dy;
@@ -818,7 +817,7 @@ void InverseSensorModel::computePaper(
 		(cls == VoxelClass::Ground ? stats.ground : cls == VoxelClass::Drop ? stats.drop : stats.obstacle)++;
 		const float peak =
 			ground ? 0.f : float(std::max(0.5, paper::densityConfidence(c.count, c.span(), m_params, res)));
-		put(idx, ground ? float(paper::groundRay(0, 0, m_params)) : peak);
+		put(idx, ground ? groundOwn : peak);
 		const double dist = std::sqrt(r2);
 		const int last = fan.lastSample(dist);
 		if (last >= 0) m_paperVoxels.push_back({idx, fan.binOf(dx, dy), last, float(dist), peak});
@@ -838,6 +837,21 @@ void InverseSensorModel::computePaper(
 	for (size_t i = 1; i < m_paperCount.size(); i++) m_paperCount[i] += m_paperCount[i - 1];
 	for (const PaperVoxel& v : m_paperSorted) m_paperVoxels[m_paperCount[size_t(v.bin)]++] = v;
 
+	// A ground voxel's evidence at sample k, K_g + (0.5 - K_g) / (1 + e^(|c_v| - r_k)),
+	// with e^(|c_v| - r_k) as e^|c_v| e^-r_k: one exp per change of the bin's farthest
+	// ground voxel instead of one per sample (the two forms differ by a few units in
+	// the last place of a double; what the map gets is a float). Up to e^300.
+	const bool factorGround = m_maxRange <= 300;
+	m_paperExpNegR.resize(size_t(std::max(samples, 0)));
+	for (int k = 0; k < samples; k++) m_paperExpNegR[size_t(k)] = std::exp(-fan.radius(k));
+	const double Kg = m_params.K_g, groundSpan = 0.5 - m_params.K_g;
+	// The cells that leave 0.5 in the sweep, in that order, appended to
+	// m_evidenceCells after it: a cell is listed at most once, so the grid's
+	// cell count bounds them (one more: each sample writes its cell at the
+	// list's end, which moves on only for a new one).
+	m_paperNewCells.resize(g.cellCount() + 1);
+	uint32_t* const newCells = m_paperNewCells.data();
+	size_t listed = 0;
 	// 3. Sweep each bin's ray from its farthest voxel to the sensor. At a
 	// sample, the ground voxels beyond it give K_g + (0.5 - K_g) / (1 + e^delta)
 	// (delta = |c_v| - r_k), strongest for the farthest one; each obstacle voxel
@@ -847,8 +861,9 @@ void InverseSensorModel::computePaper(
 	{
 		const int bin = m_paperVoxels[i].bin;
 		const double ux = std::cos(fan.angle(bin)), uy = std::sin(fan.angle(bin));
-		double farGround = -1;   // |c_v| of the farthest ground voxel reached so far
-		bool saturated = false;  // an obstacle's evidence has fallen to the floor
+		double farGround = -1;    // |c_v| of the farthest ground voxel reached so far
+		double expFarGround = 0;  // e^farGround (factorGround)
+		bool saturated = false;   // an obstacle's evidence has fallen to the floor
 		m_paperActive.clear();
 		int lastCell = -1;
 		float lastP = 0.5f;
@@ -859,17 +874,22 @@ void InverseSensorModel::computePaper(
 			for (; i < n && m_paperVoxels[i].bin == bin && m_paperVoxels[i].last >= k; i++)
 			{
 				const PaperVoxel& v = m_paperVoxels[i];
-				if (v.peak == 0.f)
-					farGround = std::max(farGround, double(v.dist));
-				else
+				if (v.peak != 0.f)
 					m_paperActive.push_back(v);
+				else if (double(v.dist) > farGround)
+				{
+					farGround = double(v.dist);
+					if (factorGround) expFarGround = std::exp(farGround);
+				}
 			}
 			const double r = fan.radius(k);
 			float occ = 0.5f, fr = saturated ? floorP : 0.5f;
 			// Ground evidence is at least K_g: once saturated at the floor, it
 			// cannot lower fr (most of a bin's samples, in front of a wall).
 			if (farGround >= r && !(saturated && groundAtLeastFloor))
-				fr = std::min(fr, float(paper::groundRay(r, farGround, m_params)));
+				fr = std::min(
+					fr, factorGround ? float(Kg + groundSpan / (1.0 + expFarGround * m_paperExpNegR[size_t(k)]))
+									 : float(paper::groundRay(r, farGround, m_params)));
 			for (size_t j = 0; j < m_paperActive.size();)
 			{
 				const float p =
@@ -895,15 +915,30 @@ void InverseSensorModel::computePaper(
 			}
 			const float p = occ > 0.5f ? occ : fr;
 			if (p == 0.5f) continue;
-			const int qx = g.ix(sx + r * ux), qy = g.iy(sy + r * uy);
+			// The sample's cell (g.ix(), g.iy() without their divisions).
+			const double ox = sx + r * ux - g.x_min, oy = sy + r * uy - g.y_min;
+			int qx, qy;
+			if (!(fastCellIndex(ox * invRes, qx) & fastCellIndex(oy * invRes, qy)))
+			{
+				qx = cellIndex(ox, res, invRes);
+				qy = cellIndex(oy, res, invRes);
+			}
 			if (!g.inside(qx, qy)) continue;
 			const int q = int(g.index(qx, qy));
 			if (q == lastCell && p == lastP) continue;
 			lastCell = q;
 			lastP = p;
-			put(uint32_t(q), p);
+			// put(), with the cell listed without a branch: whether a ray's
+			// cell was already given evidence by another bin is a coin toss
+			// near the sensor.
+			float& e = m_evidence[size_t(q)];
+			const bool wasNeutral = e == 0.5f;
+			e = ism::combine(e, p);
+			newCells[listed] = uint32_t(q);
+			listed += size_t(wasNeutral && e != 0.5f);
 		}
 	}
+	m_evidenceCells.insert(m_evidenceCells.end(), newCells, newCells + listed);
 }
 
 }  // namespace gam

@@ -304,10 +304,27 @@ constexpr float kEvidenceFloor = 0.001f;
  *          doc/paper-vs-implementation.md for this reading. */
 namespace paper
 {
-double voxelVolume(double span, double resolution);
-double densityConfidence(uint32_t count, double span, const IsmParams& p, double resolution);
-double obstacleRay(double cDist, double cvDist, double pRho, const IsmParams& p);
-double groundRay(double cDist, double cvDist, const IsmParams& p);
+// Inline: the sweep calls them per sample (an exported function is called
+// through the library's PLT).
+inline double voxelVolume(double span, double resolution)
+{
+	return resolution * resolution * std::max(span, resolution);
+}
+inline double densityConfidence(uint32_t count, double span, const IsmParams& p, double resolution)
+{
+	return p.K_m / (1.0 + std::exp(-p.K_n * (double(count) - p.d_min) / voxelVolume(span, resolution)));
+}
+inline double obstacleRay(double cDist, double cvDist, double pRho, const IsmParams& p)
+{
+	if (cDist > cvDist) return 0.5;  // eq. (6): behind the voxel, no evidence
+	const double d = cDist - cvDist;
+	return std::max(pRho, 0.5) * std::exp(-d * d / (2.0 * p.sigma2));
+}
+inline double groundRay(double cDist, double cvDist, const IsmParams& p)
+{
+	if (cDist > cvDist) return 0.5;
+	return p.K_g + (0.5 - p.K_g) / (1.0 + std::exp(-(cDist - cvDist)));
+}
 
 /** The rays of the paper model, discretized: angular bins around the sensor,
  * fine enough that neighbouring rays are half a cell apart at the maximum
@@ -327,16 +344,69 @@ struct RayFan
 	double res;
 	int bins;
 	double dtheta;
-	/** The bin of the direction (dx, dy) from the sensor. */
+	/** The bin of the direction (dx, dy) from the sensor: the nearest
+	 * multiple of dtheta to its angle std::atan2(dy, dx), halves rounded away
+	 * from zero (std::lround), modulo bins. Once per voxel, so without library
+	 * calls where it can: the angle from atanReduced() (within 1e-10 rad of
+	 * atan2's), and atan2 itself only where that could round to another bin
+	 * (within 1e-9 rad of a bin's edge). */
 	int binOf(double dx, double dy) const
 	{
-		const int b = int(std::lround(std::atan2(dy, dx) / dtheta));
+		const double ax = std::abs(dx), ay = std::abs(dy);
+		const bool steep = ay > ax;
+		const double lo = steep ? ax : ay, hi = steep ? ay : ax;
+		double a = -1;  // |angle| / dtheta
+		if (hi > 0 && hi < 1e300)
+		{
+			double t = atanReduced(lo / hi);  // the angle in [0, pi/4]
+			if (steep) t = 0.5 * M_PI - t;
+			if (dx < 0) t = M_PI - t;
+			a = t / dtheta;
+			if (std::abs(a - double(int(a)) - 0.5) <= 1e-9 / dtheta) a = -1;
+		}
+		if (a < 0) a = std::abs(std::atan2(dy, dx)) / dtheta;  // and atan2(0, -0) = pi
+		if (!(a <= double(bins))) return 0;                    // a NaN
+		// lround(a), and the sign of atan2's angle: std::signbit(dy) (a dy of
+		// -0 with dx < 0 is -pi, the same bin as pi).
+		int b = int(a);
+		b += (a - double(b)) >= 0.5;
+		if (std::signbit(dy)) b = -b;
 		return ((b % bins) + bins) % bins;
+	}
+	/** atan(z) for z in [0, 1] within 1e-10: z brought to |u| <= tan(pi/16)
+	 * around 0, pi/8 or pi/4 (atan z = c + atan((z - tan c) / (1 + z tan c))),
+	 * then the series of atan u to u^11 (the next term, u^13 / 13, is below
+	 * 6e-11). */
+	static double atanReduced(double z)
+	{
+		constexpr double kTan1 = 0.19891236737965800;  // tan(pi/16)
+		constexpr double kTan3 = 0.66817863791929890;  // tan(3 pi/16)
+		constexpr double kTanPi8 = 0.41421356237309503;
+		double c = 0, u = z;
+		if (z >= kTan3)
+		{
+			c = 0.25 * M_PI;
+			u = (z - 1.0) / (z + 1.0);
+		}
+		else if (z > kTan1)
+		{
+			c = 0.125 * M_PI;
+			u = (z - kTanPi8) / (1.0 + z * kTanPi8);
+		}
+		const double u2 = u * u;
+		const double series =
+			1.0 + u2 * (-1.0 / 3 + u2 * (1.0 / 5 + u2 * (-1.0 / 7 + u2 * (1.0 / 9 + u2 * (-1.0 / 11)))));
+		return c + u * series;
 	}
 	double angle(int bin) const { return bin * dtheta; }
 	double radius(int k) const { return (k + 0.5) * res; }
-	/** The last sample a voxel at 2D distance `dist` reaches (-1: none). */
-	int lastSample(double dist) const { return int(std::floor(dist / res - 0.5 + 1e-9)); }
+	/** The last sample a voxel at 2D distance `dist` reaches (-1: none):
+	 * floor(dist / res - 1/2 + 1e-9), the floor written out (t > -1 here). */
+	int lastSample(double dist) const
+	{
+		const double t = dist / res - 0.5 + 1e-9;
+		return t < 0 ? -1 : int(t);
+	}
 };
 }  // namespace paper
 
@@ -459,7 +529,18 @@ class InverseSensorModel
 	/** Distance of (x, y, z) from the sensor: the range the floor-noise and
 	 * floor-offset bins are indexed by. */
 	static double rangeFrom(const Eigen::Vector3d& sensor, double x, double y, double z);
-	void put(uint32_t cell, float p);
+	/** Combines p into the cell's evidence and lists the cell when it
+	 * first leaves 0.5 (ism::combine never brings it back). Evidence of
+	 * exactly 0.5 (K_g = 0 or K_m = 0) is no evidence: listing it put
+	 * neutral cells, and duplicates, into evidenceCells(). Inline: every
+	 * voxel calls it. */
+	void put(uint32_t cell, float p)
+	{
+		float& e = m_evidence[cell];
+		const bool wasNeutral = e == 0.5f;
+		e = ism::combine(e, p);
+		if (wasNeutral && e != 0.5f) m_evidenceCells.push_back(cell);
+	}
 	void computePaper(
 		const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, IsmStats& stats);
 	// Paper model workspace: in-range voxels sorted by (bin, distance
@@ -474,6 +555,8 @@ class InverseSensorModel
 	};
 	std::vector<PaperVoxel> m_paperVoxels, m_paperSorted, m_paperActive;
 	std::vector<uint32_t> m_paperCount;
+	std::vector<double> m_paperExpNegR;     ///< e^-r_k per sample of the fan
+	std::vector<uint32_t> m_paperNewCells;  ///< the sweep's newly listed cells
 	const Plane& choosePlane(const GroundDetection& det, const ElevationCell& c, double x, double y, int block) const;
 	/** P(occ) of an obstacle or drop voxel: eq. (4)-(5) of its density. */
 	float obstacleEvidence(const ElevationCell& c, double resolution) const;
