@@ -744,24 +744,19 @@ void InverseSensorModel::compute(
 
 namespace
 {
-/** floor(offset / res) as GridGeometry::ix() takes it, without its division
- * and its call to floor() (a library call without SSE4.1): the product
- * offset * invRes (invRes = 1 / res) differs from the quotient by at most
- * 3.4e-16 of it, under 1e-9 for a quotient below 1e6, so where the product
- * is in [0, 1e6) and more than 1e-9 from an integer, its truncation is the
- * quotient's floor. Elsewhere (a negative index, a NaN, near a cell's
- * border) the division decides. */
+/** GridGeometry::ix()'s floor((x - x_min) / res) from q = (x - x_min) * invRes
+ * (invRes = 1 / res), without its division and its call to floor() (a
+ * library call without SSE4.1): the product differs from the quotient by at
+ * most 3.4e-16 of it, under 1e-9 for a quotient below 1e6, so where q is in
+ * [0, 1e6) and more than 1e-9 from an integer, its truncation i is the
+ * quotient's floor. False elsewhere (a negative index, a NaN, near a cell's
+ * border): ix() decides there. */
 inline bool fastCellIndex(double q, int& i)
 {
 	const bool inRange = q >= 0 && q < 1e6;  // false for a NaN
 	i = int(inRange ? q : 0.0);
 	const double frac = q - double(i);
 	return inRange & (frac > 1e-9) & (frac < 1.0 - 1e-9);
-}
-inline int cellIndex(double offset, double res, double invRes)
-{
-	int i;
-	return fastCellIndex(offset * invRes, i) ? i : GridGeometry::toIndex(std::floor(offset / res));
 }
 }  // namespace
 
@@ -787,16 +782,11 @@ void InverseSensorModel::computePaper(
 	// 1. Classify every voxel in range (ground: both ends within d_pth); its
 	// own cell gets eq. (5) at |c| = |c_v|.
 	m_paperVoxels.clear();
-	const double invNx = 1.0 / g.nx;
 	const float groundOwn = float(paper::groundRay(0, 0, m_params));
 	for (uint32_t idx : frame.observedCells())
 	{
 		const ElevationCell& c = frame.cell(idx);
-		// idx / nx without a division: the product is within one of it.
-		int cy = int(double(idx) * invNx);
-		cy -= int(uint32_t(cy) * uint32_t(g.nx) > idx);
-		cy += int(uint32_t(cy + 1) * uint32_t(g.nx) <= idx);
-		const int cx = int(idx - uint32_t(cy) * uint32_t(g.nx));
+		const int cx = int(idx % uint32_t(g.nx)), cy = int(idx / uint32_t(g.nx));
 		const double x = g.cx(cx), y = g.cy(cy);
 		const double dx = x - sx, dy = y - sy;
 		const double r2 = dx * dx + dy * dy;
@@ -915,13 +905,14 @@ void InverseSensorModel::computePaper(
 			}
 			const float p = occ > 0.5f ? occ : fr;
 			if (p == 0.5f) continue;
-			// The sample's cell (g.ix(), g.iy() without their divisions).
-			const double ox = sx + r * ux - g.x_min, oy = sy + r * uy - g.y_min;
+			// The sample's cell: g.ix(), g.iy(), without their divisions where
+			// that gives the same cells.
+			const double x = sx + r * ux, y = sy + r * uy;
 			int qx, qy;
-			if (!(fastCellIndex(ox * invRes, qx) & fastCellIndex(oy * invRes, qy)))
+			if (!(fastCellIndex((x - g.x_min) * invRes, qx) & fastCellIndex((y - g.y_min) * invRes, qy)))
 			{
-				qx = cellIndex(ox, res, invRes);
-				qy = cellIndex(oy, res, invRes);
+				qx = g.ix(x);
+				qy = g.iy(y);
 			}
 			if (!g.inside(qx, qy)) continue;
 			const int q = int(g.index(qx, qy));
@@ -931,11 +922,8 @@ void InverseSensorModel::computePaper(
 			// put(), with the cell listed without a branch: whether a ray's
 			// cell was already given evidence by another bin is a coin toss
 			// near the sensor.
-			float& e = m_evidence[size_t(q)];
-			const bool wasNeutral = e == 0.5f;
-			e = ism::combine(e, p);
 			newCells[listed] = uint32_t(q);
-			listed += size_t(wasNeutral && e != 0.5f);
+			listed += size_t(combineEvidence(uint32_t(q), p));
 		}
 	}
 	m_evidenceCells.insert(m_evidenceCells.end(), newCells, newCells + listed);

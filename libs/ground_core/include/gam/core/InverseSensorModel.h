@@ -401,7 +401,8 @@ struct RayFan
 	double angle(int bin) const { return bin * dtheta; }
 	double radius(int k) const { return (k + 0.5) * res; }
 	/** The last sample a voxel at 2D distance `dist` reaches (-1: none):
-	 * floor(dist / res - 1/2 + 1e-9), the floor written out (t > -1 here). */
+	 * floor(dist / res - 1/2 + 1e-9), the floor written out (t > -1 here):
+	 * std::floor is a library call on a build for plain x86-64, once per voxel. */
 	int lastSample(double dist) const
 	{
 		const double t = dist / res - 0.5 + 1e-9;
@@ -529,17 +530,21 @@ class InverseSensorModel
 	/** Distance of (x, y, z) from the sensor: the range the floor-noise and
 	 * floor-offset bins are indexed by. */
 	static double rangeFrom(const Eigen::Vector3d& sensor, double x, double y, double z);
-	/** Combines p into the cell's evidence and lists the cell when it
-	 * first leaves 0.5 (ism::combine never brings it back). Evidence of
-	 * exactly 0.5 (K_g = 0 or K_m = 0) is no evidence: listing it put
-	 * neutral cells, and duplicates, into evidenceCells(). Inline: every
-	 * voxel calls it. */
-	void put(uint32_t cell, float p)
+	/** Combines p into the cell's evidence; true when that made it leave
+	 * 0.5 (ism::combine never brings it back): the cell is to be listed.
+	 * Evidence of exactly 0.5 (K_g = 0 or K_m = 0) is no evidence: listing
+	 * it put neutral cells, and duplicates, into evidenceCells(). */
+	bool combineEvidence(uint32_t cell, float p)
 	{
 		float& e = m_evidence[cell];
 		const bool wasNeutral = e == 0.5f;
 		e = ism::combine(e, p);
-		if (wasNeutral && e != 0.5f) m_evidenceCells.push_back(cell);
+		return wasNeutral && e != 0.5f;
+	}
+	/** combineEvidence(), listing the cell. Inline: every voxel calls it. */
+	void put(uint32_t cell, float p)
+	{
+		if (combineEvidence(cell, p)) m_evidenceCells.push_back(cell);
 	}
 	void computePaper(
 		const ElevationGrid& frame, const GroundDetection& det, const Eigen::Vector3d& sensor, IsmStats& stats);
